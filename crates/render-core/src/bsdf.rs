@@ -1,0 +1,130 @@
+//! Reflection BSDF at a surface point: Lambert plus a GGX lobe with Schlick Fresnel.
+//!
+//! Directions are in world space; the BSDF works in the local frame of the shading normal,
+//! flipped to the viewer's side. A direction below the geometric surface (as seen from the
+//! viewer) gets zero: this renderer has no transmission.
+use crate::frame::Frame;
+use crate::material::BsdfParams;
+use crate::microfacet::{Ggx, reflect, schlick};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Bsdf {
+    /// Shading frame; z is the shading normal on the viewer's side.
+    pub frame: Frame,
+    /// Geometric normal on the viewer's side.
+    pub ng: Vec3,
+    pub params: BsdfParams,
+    pub ggx: Ggx,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    /// f · |cos θi| (shading normal).
+    pub f_cos: Vec3,
+    /// Solid-angle density of `wi`.
+    pub pdf: f32,
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+impl Bsdf {
+    /// `ns`, `ng`: shading and geometric normals (any orientation); `wo` points away from the surface.
+    pub fn new(ns: Vec3, ng: Vec3, wo: Vec3, params: BsdfParams) -> Bsdf {
+        let ng = if ng.dot(wo) < 0.0 { -ng } else { ng };
+        let mut ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
+        if !ns.is_finite() || ns.length_squared() < 0.5 {
+            ns = ng;
+        }
+        Bsdf { frame: Frame::from_normal_and_direction(ns, wo), ng, params, ggx: Ggx::new(params.alpha) }
+    }
+
+    /// True when the specular lobe is absent (the paper skips BRDF-oriented sampling there).
+    pub fn is_pure_diffuse(&self) -> bool {
+        self.params.f0.max_element() <= 0.0
+    }
+
+    pub fn has_diffuse(&self) -> bool {
+        self.params.diffuse.max_element() > 0.0
+    }
+
+    /// Probability of choosing the specular lobe when sampling, a fixed function of (wo, params).
+    pub fn specular_probability(&self, wo_local: Vec3) -> f32 {
+        if self.is_pure_diffuse() {
+            return 0.0;
+        }
+        if !self.has_diffuse() {
+            return 1.0;
+        }
+        let s = luminance(schlick(self.params.f0, wo_local.z));
+        let d = luminance(self.params.diffuse);
+        (s / (s + d)).clamp(0.25, 0.9)
+    }
+
+    fn valid(&self, wo: Vec3, wi: Vec3) -> bool {
+        wo.dot(self.ng) > 0.0 && wi.dot(self.ng) > 0.0
+    }
+
+    /// f(wo, wi) · cos θi (shading normal).
+    pub fn eval_cos(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if !self.valid(wo, wi) {
+            return Vec3::ZERO;
+        }
+        let lo = self.frame.to_local(wo);
+        let li = self.frame.to_local(wi);
+        if lo.z <= 0.0 || li.z <= 0.0 {
+            return Vec3::ZERO;
+        }
+        let mut f = self.params.diffuse * (li.z / PI);
+        if !self.is_pure_diffuse() {
+            let h = (lo + li).normalize();
+            f += schlick(self.params.f0, li.dot(h)) * self.ggx.eval_cos(lo, li);
+        }
+        f
+    }
+
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if !self.valid(wo, wi) {
+            return 0.0;
+        }
+        let lo = self.frame.to_local(wo);
+        let li = self.frame.to_local(wi);
+        if lo.z <= 0.0 || li.z <= 0.0 {
+            return 0.0;
+        }
+        let ps = self.specular_probability(lo);
+        let mut pdf = (1.0 - ps) * li.z / PI;
+        if ps > 0.0 {
+            pdf += ps * self.ggx.reflection_pdf(lo, li);
+        }
+        pdf
+    }
+
+    /// Sample a direction: `u_lobe` picks the lobe, `u` drives it.
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2) -> Option<BsdfSample> {
+        let lo = self.frame.to_local(wo);
+        if lo.z <= 0.0 || wo.dot(self.ng) <= 0.0 {
+            return None;
+        }
+        let ps = self.specular_probability(lo);
+        let li = if u_lobe < ps {
+            let h = self.ggx.sample_visible_normal(lo, u);
+            reflect(lo, h)
+        } else {
+            crate::sampling::cosine_hemisphere(u)
+        };
+        if li.z <= 0.0 {
+            return None;
+        }
+        let wi = self.frame.to_world(li);
+        let pdf = self.pdf(wo, wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        Some(BsdfSample { wi, f_cos: self.eval_cos(wo, wi), pdf })
+    }
+}

@@ -1,0 +1,44 @@
+//! Pinhole perspective camera.
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct Camera {
+    pub name: String,
+    pub position: Vec3,
+    /// Unit view direction.
+    pub forward: Vec3,
+    /// Unit up vector, orthogonal to `forward`.
+    pub up: Vec3,
+    /// Vertical field of view in radians.
+    pub yfov: f32,
+    /// Preferred image size; the command line may override it.
+    pub width: u32,
+    pub height: u32,
+}
+
+impl Camera {
+    pub fn look_at(name: &str, eye: Vec3, target: Vec3, up: Vec3, yfov: f32, width: u32, height: u32) -> Camera {
+        let forward = (target - eye).normalize();
+        let right = forward.cross(up).normalize();
+        Camera { name: name.to_string(), position: eye, forward, up: right.cross(forward), yfov, width, height }
+    }
+
+    /// A camera framing an axis-aligned box from the front-upper side (used when a glTF file has none).
+    pub fn framing(lo: Vec3, hi: Vec3, width: u32, height: u32) -> Camera {
+        let center = 0.5 * (lo + hi);
+        let radius = (0.5 * (hi - lo).length()).max(1e-3);
+        let yfov = 45f32.to_radians();
+        let dist = radius / (0.5 * yfov).sin() * 1.05;
+        let dir = Vec3::new(0.0, 0.35, 1.0).normalize();
+        Camera::look_at("default", center + dir * dist, center, Vec3::Y, yfov, width, height)
+    }
+
+    /// World ray through film position `film` in [0,1]² (x right, y down) for an image of the given aspect.
+    pub fn ray_direction(&self, film: Vec2, aspect: f32) -> Vec3 {
+        let tan = (0.5 * self.yfov).tan();
+        let right = self.forward.cross(self.up);
+        let sx = (2.0 * film.x - 1.0) * tan * aspect;
+        let sy = (1.0 - 2.0 * film.y) * tan;
+        (self.forward + right * sx + self.up * sy).normalize()
+    }
+}

@@ -1,0 +1,24 @@
+//! Errors a user can cause with bad input: each names the problem in one line.
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum SceneError {
+    #[error("cannot read scene file {path}: {message}")]
+    Io { path: String, message: String },
+    #[error("malformed glTF {path}: {message}")]
+    Gltf { path: String, message: String },
+    #[error("scene has no triangles and no lights")]
+    Empty,
+    #[error("non-finite vertex position in mesh `{mesh}`")]
+    NonFiniteVertex { mesh: String },
+    #[error("invalid emission in {what}: {value} (must be finite and non-negative)")]
+    BadEmission { what: String, value: String },
+    #[error("invalid light `{what}`: {message}")]
+    BadLight { what: String, message: String },
+    #[error("camera `{0}` not found in the scene")]
+    CameraNotFound(String),
+    #[error("unknown built-in scene `{name}` (known: {known})")]
+    UnknownBuiltin { name: String, known: String },
+    #[error("bad parameter `{key}` for built-in scene `{scene}`: {message}")]
+    BadBuiltinParam { scene: String, key: String, message: String },
+}

@@ -1,0 +1,75 @@
+//! The interface between the render loop and light-sampling strategies.
+use crate::bsdf::Bsdf;
+use crate::light::LightSample;
+use crate::rng::SampleStream;
+use crate::scene::{Scene, SurfaceHit, offset_origin};
+use crate::stats::Counters;
+use glam::Vec3;
+
+/// Most per-pixel diagnostic channels a strategy can write.
+pub const MAX_AUX: usize = 4;
+/// Floats of per-pixel memory a strategy may keep across passes of the same pixel.
+pub const PIXEL_MEMORY: usize = 4;
+
+/// A camera-ray hit on a reflecting surface, ready for direct lighting.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadingPoint {
+    pub hit: SurfaceHit,
+    /// Unit direction towards the viewer.
+    pub wo: Vec3,
+    pub bsdf: Bsdf,
+}
+
+impl ShadingPoint {
+    pub fn point(&self) -> Vec3 {
+        self.hit.point
+    }
+
+    /// Ray origin for a ray leaving in direction `w`.
+    pub fn origin_towards(&self, w: Vec3) -> Vec3 {
+        offset_origin(self.hit.point, self.hit.ng, w)
+    }
+
+    /// Unoccluded contribution f·cos·L of a light sample, before dividing by any pdf; traces the
+    /// shadow ray only when the unshadowed value is non-zero.
+    pub fn shade(&self, scene: &Scene, s: &LightSample, counters: &mut Counters) -> Vec3 {
+        let f = self.bsdf.eval_cos(self.wo, s.wi) * s.radiance;
+        if f == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        counters.shadow_rays += 1;
+        let o = self.origin_towards(s.wi);
+        if scene.occluded(o, s.wi, (s.point - o).length()) { Vec3::ZERO } else { f }
+    }
+}
+
+/// What a strategy may write besides its radiance estimate.
+pub struct SampleContext<'a> {
+    pub counters: &'a mut Counters,
+    /// Diagnostic values of this sample, averaged per pixel (channel names: `aux_channels`).
+    pub aux: [f32; MAX_AUX],
+    /// Persistent per-pixel memory, carried across the samples and passes of the pixel in
+    /// sample order (e.g. statistics that fix sample allocations before later samples are drawn).
+    pub pixel_memory: &'a mut [f32; PIXEL_MEMORY],
+}
+
+/// A direct-lighting estimator for bounded lights (distant lights are handled by the render loop).
+pub trait DirectLighting: Send + Sync {
+    /// The strategy's name as the command line spells it.
+    fn name(&self) -> String;
+    /// Parameters worth recording in the render's JSON.
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::Value::Null
+    }
+    /// Names of the techniques whose sample counts go into `Counters::technique_samples`.
+    fn techniques(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
+    /// Names of the per-pixel diagnostic channels written to `SampleContext::aux`.
+    fn aux_channels(&self) -> Vec<&'static str> {
+        Vec::new()
+    }
+    /// An unbiased (unless documented otherwise) estimate of the radiance reflected towards
+    /// `sp.wo` from the scene's bounded lights.
+    fn estimate(&self, scene: &Scene, sp: &ShadingPoint, rng: &mut SampleStream, ctx: &mut SampleContext) -> Vec3;
+}

@@ -1,0 +1,26 @@
+//! `render-core`: what every strategy and tool of the manylights renderer stands on.
+//!
+//! It owns the scene (geometry, materials, lights, cameras), ray casting through an obvhs
+//! CWBVH, the BSDF of a hit, the per-sample random numbers, the render loop and image output.
+//! Light-sampling strategies live in the `samplers` crate and plug in through
+//! [`estimator::DirectLighting`].
+
+pub mod accel;
+pub mod bsdf;
+pub mod camera;
+pub mod error;
+pub mod estimator;
+pub mod frame;
+pub mod light;
+pub mod material;
+pub mod microfacet;
+pub mod output;
+pub mod render;
+pub mod rng;
+pub mod sampling;
+pub mod scene;
+pub mod stats;
+pub mod texture;
+
+pub use error::SceneError;
+pub use glam::{Vec2, Vec3};

@@ -1,0 +1,229 @@
+//! Lights with bounded extent: emissive triangles, sphere lights, point and spot lights.
+//! Each can sample a point as seen from a shading point and evaluate the solid-angle density
+//! of any point on it, so every technique can weight any other by MIS.
+//! Distant (directional) lights have no extent and live apart in [`DistantLight`].
+use crate::frame::Frame;
+use crate::sampling;
+use crate::texture::Texture;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+#[derive(Clone, Debug)]
+pub enum LightShape {
+    /// Vertices counter-clockwise around `normal`; `uv` only matters with an emission texture.
+    Triangle { p: [Vec3; 3], normal: Vec3, area: f32, uv: [Vec2; 3] },
+    Sphere { center: Vec3, radius: f32 },
+    Point { position: Vec3 },
+}
+
+/// Angular falloff of a spot light (glTF: smooth between inner and outer cone).
+#[derive(Clone, Copy, Debug)]
+pub struct SpotCone {
+    /// Unit emission axis.
+    pub direction: Vec3,
+    pub cos_inner: f32,
+    pub cos_outer: f32,
+}
+
+impl SpotCone {
+    pub fn falloff(&self, w_out: Vec3) -> f32 {
+        let c = self.direction.dot(w_out);
+        if c <= self.cos_outer {
+            return 0.0;
+        }
+        if c >= self.cos_inner {
+            return 1.0;
+        }
+        let t = (c - self.cos_outer) / (self.cos_inner - self.cos_outer).max(1e-6);
+        t * t
+    }
+}
+
+#[derive(Clone, Debug)]
+pub struct Light {
+    pub shape: LightShape,
+    /// Radiance (triangles, spheres) or intensity (points), linear RGB.
+    pub emission: Vec3,
+    /// Triangles only: emission is multiplied by this texture at the point's uv.
+    pub texture: Option<Arc<Texture>>,
+    /// Mean emission over the surface (equals `emission` without a texture).
+    pub mean_emission: Vec3,
+    pub two_sided: bool,
+    pub spot: Option<SpotCone>,
+}
+
+/// A point on a light as seen from a shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    pub point: Vec3,
+    /// Unit surface normal at `point` (zero for point lights).
+    pub normal: Vec3,
+    /// Unit direction from the shading point to `point`.
+    pub wi: Vec3,
+    pub dist: f32,
+    /// Radiance arriving along −wi (for delta lights: intensity / dist², the density being 1).
+    pub radiance: Vec3,
+    /// Solid-angle density of `wi` (1 for delta lights).
+    pub pdf: f32,
+    pub is_delta: bool,
+}
+
+pub fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+impl Light {
+    pub fn is_delta(&self) -> bool {
+        matches!(self.shape, LightShape::Point { .. })
+    }
+
+    /// Emitted power in watts (luminance of the radiance), in one unit across kinds:
+    /// one-sided emitter π·L·A, two-sided 2π·L·A, sphere π·L·4πr², point 4π·I.
+    pub fn power(&self) -> f32 {
+        let l = luminance(self.mean_emission).max(0.0);
+        match &self.shape {
+            LightShape::Triangle { area, .. } => l * area * if self.two_sided { 2.0 * PI } else { PI },
+            LightShape::Sphere { radius, .. } => l * PI * 4.0 * PI * radius * radius,
+            LightShape::Point { .. } => 4.0 * PI * l,
+        }
+    }
+
+    /// Axis-aligned bounds.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        match &self.shape {
+            LightShape::Triangle { p, .. } => (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2])),
+            LightShape::Sphere { center, radius } => (center - Vec3::splat(*radius), center + Vec3::splat(*radius)),
+            LightShape::Point { position } => (*position, *position),
+        }
+    }
+
+    /// Orientation cone (axis, θo, θe) in the sense of Conty Estevez & Kulla 2018.
+    pub fn orientation(&self) -> (Vec3, f32, f32) {
+        match (&self.shape, &self.spot) {
+            (LightShape::Triangle { normal, .. }, _) => (*normal, 0.0, PI / 2.0),
+            (_, Some(s)) => {
+                let inner = s.cos_inner.clamp(-1.0, 1.0).acos();
+                let outer = s.cos_outer.clamp(-1.0, 1.0).acos();
+                (s.direction, inner, (outer - inner).max(0.0))
+            }
+            _ => (Vec3::Z, PI, PI / 2.0),
+        }
+    }
+
+    /// Emitted radiance leaving `point` (normal `normal`, texture coordinate `uv`) in direction `w_out`.
+    pub fn emitted(&self, normal: Vec3, uv: Vec2, w_out: Vec3) -> Vec3 {
+        let facing = normal.dot(w_out);
+        match &self.shape {
+            LightShape::Triangle { .. } => {
+                if facing <= 0.0 && !self.two_sided {
+                    return Vec3::ZERO;
+                }
+                match &self.texture {
+                    Some(t) => self.emission * t.sample(uv).truncate(),
+                    None => self.emission,
+                }
+            }
+            LightShape::Sphere { .. } => {
+                if facing <= 0.0 {
+                    return Vec3::ZERO;
+                }
+                self.emission * self.spot.map_or(1.0, |s| s.falloff(w_out))
+            }
+            LightShape::Point { .. } => self.emission * self.spot.map_or(1.0, |s| s.falloff(w_out)),
+        }
+    }
+
+    /// Sample a point on the light as seen from `x`: triangles uniformly by area, spheres
+    /// uniformly in the cone of directions they subtend. `None` when nothing can be sampled
+    /// or the sampled point emits nothing towards `x`.
+    pub fn sample(&self, x: Vec3, u: Vec2) -> Option<LightSample> {
+        match &self.shape {
+            LightShape::Triangle { p, normal, area, uv } => {
+                let b = sampling::uniform_triangle(u);
+                let point = p[0] * (1.0 - b.x - b.y) + p[1] * b.x + p[2] * b.y;
+                let d = point - x;
+                let dist2 = d.length_squared();
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos_l = normal.dot(-wi);
+                if dist2 <= 0.0 || cos_l.abs() <= 0.0 {
+                    return None;
+                }
+                let tuv = uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y;
+                let radiance = self.emitted(*normal, tuv, -wi);
+                if radiance == Vec3::ZERO {
+                    return None;
+                }
+                Some(LightSample { point, normal: *normal, wi, dist, radiance, pdf: dist2 / (area * cos_l.abs()), is_delta: false })
+            }
+            LightShape::Sphere { center, radius } => {
+                let d = *center - x;
+                let dist_c = d.length();
+                if dist_c <= *radius {
+                    return None; // the shading point is inside the light: it sees nothing but the light's inside
+                }
+                let omc = sampling::sphere_cone_one_minus_cos(*radius, dist_c);
+                let axis = d / dist_c;
+                let local = sampling::uniform_cone(u, omc);
+                let wi = Frame::from_normal(axis).to_world(local).normalize();
+                let sin2 = local.x * local.x + local.y * local.y;
+                let cos_t = local.z;
+                let t = (dist_c * cos_t - (radius * radius - dist_c * dist_c * sin2).max(0.0).sqrt()).max(0.0);
+                let point = x + wi * t;
+                let normal = (point - *center).normalize_or(-axis);
+                let radiance = self.emitted(normal, Vec2::ZERO, -wi);
+                if radiance == Vec3::ZERO {
+                    return None;
+                }
+                Some(LightSample { point, normal, wi, dist: t, radiance, pdf: sampling::uniform_cone_pdf(omc), is_delta: false })
+            }
+            LightShape::Point { position } => {
+                let d = *position - x;
+                let dist2 = d.length_squared();
+                if dist2 <= 0.0 {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let radiance = self.emitted(Vec3::ZERO, Vec2::ZERO, -wi) / dist2;
+                if radiance == Vec3::ZERO {
+                    return None;
+                }
+                Some(LightSample { point: *position, normal: Vec3::ZERO, wi, dist, radiance, pdf: 1.0, is_delta: true })
+            }
+        }
+    }
+
+    /// Solid-angle density with which [`Light::sample`] from `x` produces the point `point`
+    /// (normal `normal`) of this light. Zero for delta lights and for points that emit nothing towards `x`.
+    pub fn pdf(&self, x: Vec3, point: Vec3, normal: Vec3) -> f32 {
+        match &self.shape {
+            LightShape::Triangle { area, .. } => {
+                let d = point - x;
+                let dist2 = d.length_squared();
+                let cos_l = normal.dot(-d) / dist2.sqrt();
+                if cos_l <= 0.0 && !self.two_sided || cos_l == 0.0 || dist2 <= 0.0 {
+                    return 0.0;
+                }
+                dist2 / (area * cos_l.abs())
+            }
+            LightShape::Sphere { center, radius } => {
+                let dist_c = (*center - x).length();
+                if dist_c <= *radius {
+                    return 0.0;
+                }
+                sampling::uniform_cone_pdf(sampling::sphere_cone_one_minus_cos(*radius, dist_c))
+            }
+            LightShape::Point { .. } => 0.0,
+        }
+    }
+}
+
+/// A directional light: parallel illumination of irradiance `irradiance` (lux) from `direction`.
+#[derive(Clone, Copy, Debug)]
+pub struct DistantLight {
+    /// Unit direction towards the light.
+    pub direction: Vec3,
+    pub irradiance: Vec3,
+}

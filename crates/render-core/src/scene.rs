@@ -1,0 +1,347 @@
+//! The scene: triangles, materials, lights, cameras and the acceleration structure,
+//! assembled through [`SceneBuilder`] by the glTF loader and the built-in generators.
+use crate::accel::{Accel, Primitive};
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::light::{DistantLight, Light, LightShape, SpotCone};
+use crate::material::Material;
+use glam::{Mat4, Vec2, Vec3};
+use serde::Serialize;
+use std::sync::Arc;
+
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// One triangle with its shading attributes.
+#[derive(Clone, Debug)]
+pub struct Triangle {
+    pub p: [Vec3; 3],
+    /// Shading normals (the geometric normal repeated when the mesh has none).
+    pub n: [Vec3; 3],
+    pub uv: [Vec2; 3],
+    pub material: u32,
+    /// The area light this triangle is, or [`NO_LIGHT`].
+    pub light: u32,
+}
+
+/// Counts that `manylights info` prints.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct SceneStats {
+    pub triangles: usize,
+    pub degenerate_triangles_skipped: usize,
+    pub triangle_lights: usize,
+    pub sphere_lights: usize,
+    pub point_lights: usize,
+    pub spot_lights: usize,
+    pub distant_lights: usize,
+    /// Emissive triangles whose emission averages to zero (not lights).
+    pub black_emissive_triangles: usize,
+    pub total_power_w: f64,
+}
+
+/// Where a ray met the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceHit {
+    pub point: Vec3,
+    pub t: f32,
+    /// Geometric normal (unit, not flipped).
+    pub ng: Vec3,
+    /// Interpolated shading normal (unit, not flipped).
+    pub ns: Vec3,
+    pub uv: Vec2,
+    /// Material index, or `None` for a sphere light (black surface).
+    pub material: Option<u32>,
+    /// The light this surface belongs to, or [`NO_LIGHT`].
+    pub light: u32,
+}
+
+pub struct Scene {
+    pub name: String,
+    pub triangles: Vec<Triangle>,
+    pub materials: Vec<Material>,
+    pub lights: Vec<Light>,
+    /// Light index of each sphere light, in primitive order after the triangles.
+    pub sphere_prims: Vec<u32>,
+    pub distant_lights: Vec<DistantLight>,
+    pub cameras: Vec<Camera>,
+    pub bounds: (Vec3, Vec3),
+    pub stats: SceneStats,
+    pub accel: Accel,
+}
+
+impl Scene {
+    /// Geometry at a hit returned by the accelerator.
+    pub fn surface(&self, origin: Vec3, dir: Vec3, hit: &crate::accel::Hit) -> SurfaceHit {
+        let point = origin + dir * hit.t;
+        let ntri = self.triangles.len() as u32;
+        if hit.prim < ntri {
+            let tri = &self.triangles[hit.prim as usize];
+            let b0 = 1.0 - hit.b1 - hit.b2;
+            let ng = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize();
+            let ns = (tri.n[0] * b0 + tri.n[1] * hit.b1 + tri.n[2] * hit.b2).normalize_or(ng);
+            let uv = tri.uv[0] * b0 + tri.uv[1] * hit.b1 + tri.uv[2] * hit.b2;
+            SurfaceHit { point, t: hit.t, ng, ns, uv, material: Some(tri.material), light: tri.light }
+        } else {
+            let light = self.sphere_prims[(hit.prim - ntri) as usize];
+            let LightShape::Sphere { center, .. } = self.lights[light as usize].shape else {
+                unreachable!("sphere primitives map to sphere lights")
+            };
+            let n = (point - center).normalize_or(-dir);
+            SurfaceHit { point, t: hit.t, ng: n, ns: n, uv: Vec2::ZERO, material: None, light }
+        }
+    }
+
+    /// Closest surface along a ray.
+    pub fn intersect(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<SurfaceHit> {
+        self.accel.intersect(origin, dir, tmin, tmax).map(|h| self.surface(origin, dir, &h))
+    }
+
+    /// True when the segment from `origin` (already offset off its surface) along `dir` up to
+    /// `dist` is blocked. The far end is shortened so the light's own surface never occludes.
+    pub fn occluded(&self, origin: Vec3, dir: Vec3, dist: f32) -> bool {
+        self.accel.occluded(origin, dir, 0.0, dist * (1.0 - 1e-4) - ray_epsilon(origin + dir * dist))
+    }
+
+    /// Scene diagonal, a length scale for defaults.
+    pub fn diagonal(&self) -> f32 {
+        (self.bounds.1 - self.bounds.0).length()
+    }
+
+    pub fn camera(&self, name: Option<&str>) -> Result<Camera, SceneError> {
+        match name {
+            Some(n) => self.cameras.iter().find(|c| c.name == n).cloned().ok_or_else(|| SceneError::CameraNotFound(n.into())),
+            None => Ok(self.cameras.first().cloned().unwrap_or_else(|| Camera::framing(self.bounds.0, self.bounds.1, 512, 512))),
+        }
+    }
+}
+
+/// Offset that moves a ray origin off the surface it starts on: scaled with the coordinates'
+/// magnitude, as f32 rounding is.
+pub fn ray_epsilon(p: Vec3) -> f32 {
+    1e-6 * (1.0 + p.abs().max_element()) * 8.0
+}
+
+/// Moves `p` off its surface towards the side `w` leaves through.
+pub fn offset_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
+    let e = ray_epsilon(p);
+    if ng.dot(w) >= 0.0 { p + ng * e } else { p - ng * e }
+}
+
+/// Collects geometry, materials and lights, validates them and builds a [`Scene`].
+pub struct SceneBuilder {
+    name: String,
+    triangles: Vec<Triangle>,
+    materials: Vec<Material>,
+    lights: Vec<Light>,
+    spheres: Vec<u32>,
+    distant: Vec<DistantLight>,
+    cameras: Vec<Camera>,
+    stats: SceneStats,
+}
+
+fn check_emission(what: &str, e: Vec3) -> Result<(), SceneError> {
+    if !e.is_finite() || e.min_element() < 0.0 {
+        return Err(SceneError::BadEmission { what: what.into(), value: format!("{:?}", e.to_array()) });
+    }
+    Ok(())
+}
+
+/// Mean of an emission texture over a triangle, by a stratified barycentric grid whose
+/// density follows the triangle's footprint in texels.
+fn mean_over_triangle(tex: &crate::texture::Texture, uv: [Vec2; 3]) -> Vec3 {
+    let texels = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs() * (tex.width * tex.height) as f32;
+    let n = (texels.sqrt() * 2.0).clamp(4.0, 64.0) as usize;
+    let mut sum = Vec3::ZERO;
+    let mut count = 0usize;
+    for i in 0..n {
+        for j in 0..n {
+            let u = Vec2::new((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+            let b = crate::sampling::uniform_triangle(u);
+            let t = uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y;
+            sum += tex.sample(t).truncate();
+            count += 1;
+        }
+    }
+    sum / count as f32
+}
+
+impl SceneBuilder {
+    pub fn new(name: &str) -> SceneBuilder {
+        SceneBuilder {
+            name: name.into(),
+            triangles: Vec::new(),
+            materials: Vec::new(),
+            lights: Vec::new(),
+            spheres: Vec::new(),
+            distant: Vec::new(),
+            cameras: Vec::new(),
+            stats: SceneStats::default(),
+        }
+    }
+
+    pub fn add_material(&mut self, m: Material) -> Result<u32, SceneError> {
+        check_emission(&format!("material `{}`", m.name), m.emission)?;
+        self.materials.push(m);
+        Ok(self.materials.len() as u32 - 1)
+    }
+
+    pub fn material(&self, index: u32) -> &Material {
+        &self.materials[index as usize]
+    }
+
+    /// Adds an indexed triangle mesh under `transform`. Degenerate triangles are skipped and
+    /// counted; non-finite positions are an error. Triangles of an emissive material become
+    /// area lights unless their emission averages to zero.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add_mesh(
+        &mut self,
+        mesh_name: &str,
+        positions: &[Vec3],
+        normals: Option<&[Vec3]>,
+        uvs: Option<&[Vec2]>,
+        indices: &[u32],
+        transform: Mat4,
+        material: u32,
+    ) -> Result<(), SceneError> {
+        if positions.iter().any(|p| !p.is_finite()) || !transform.is_finite() {
+            return Err(SceneError::NonFiniteVertex { mesh: mesh_name.into() });
+        }
+        let normal_matrix = transform.inverse().transpose();
+        let flips = transform.determinant() < 0.0;
+        let wp: Vec<Vec3> = positions.iter().map(|p| transform.transform_point3(*p)).collect();
+        let wn: Option<Vec<Vec3>> = normals.map(|ns| ns.iter().map(|n| normal_matrix.transform_vector3(*n).normalize_or_zero()).collect());
+        let mat = self.materials[material as usize].clone();
+        for (k, idx) in indices.chunks_exact(3).enumerate() {
+            let (mut i0, i1, mut i2) = (idx[0] as usize, idx[1] as usize, idx[2] as usize);
+            if [i0, i1, i2].iter().any(|&i| i >= wp.len()) {
+                return Err(SceneError::Gltf { path: mesh_name.into(), message: format!("triangle {k} indexes past the vertex array") });
+            }
+            if flips {
+                std::mem::swap(&mut i0, &mut i2); // keep counter-clockwise = front
+            }
+            let p = [wp[i0], wp[i1], wp[i2]];
+            let cross = (p[1] - p[0]).cross(p[2] - p[0]);
+            let area = 0.5 * cross.length();
+            if !(area > 1e-12 * (1.0 + p[0].abs().max_element()).powi(2)) || !cross.is_finite() {
+                self.stats.degenerate_triangles_skipped += 1;
+                continue;
+            }
+            let ng = cross.normalize();
+            let n = match &wn {
+                Some(wn) => [i0, i1, i2].map(|i| if wn[i] == Vec3::ZERO || !wn[i].is_finite() { ng } else { wn[i] }),
+                None => [ng; 3],
+            };
+            let uv = match uvs {
+                Some(uv) if uv.len() == positions.len() => [uv[i0], uv[i1], uv[i2]],
+                _ => [Vec2::ZERO; 3],
+            };
+            let mut light = NO_LIGHT;
+            if mat.is_emissive() {
+                let mean = match &mat.emission_texture {
+                    Some(t) => mat.emission * mean_over_triangle(t, uv),
+                    None => mat.emission,
+                };
+                if mean.max_element() > 0.0 {
+                    light = self.lights.len() as u32;
+                    self.lights.push(Light {
+                        shape: LightShape::Triangle { p, normal: ng, area, uv },
+                        emission: mat.emission,
+                        texture: mat.emission_texture.clone(),
+                        mean_emission: mean,
+                        two_sided: mat.double_sided,
+                        spot: None,
+                    });
+                    self.stats.triangle_lights += 1;
+                } else {
+                    self.stats.black_emissive_triangles += 1;
+                }
+            }
+            self.triangles.push(Triangle { p, n, uv, material, light });
+        }
+        Ok(())
+    }
+
+    /// A sphere light of radius `radius` > 0 and uniform radiance.
+    pub fn add_sphere_light(&mut self, center: Vec3, radius: f32, radiance: Vec3, spot: Option<SpotCone>) -> Result<(), SceneError> {
+        check_emission("sphere light", radiance)?;
+        if !center.is_finite() || !(radius > 0.0) || !radius.is_finite() {
+            return Err(SceneError::BadLight { what: "sphere".into(), message: format!("center {center:?}, radius {radius}") });
+        }
+        self.spheres.push(self.lights.len() as u32);
+        self.lights.push(Light { shape: LightShape::Sphere { center, radius }, emission: radiance, texture: None, mean_emission: radiance, two_sided: false, spot });
+        self.stats.sphere_lights += 1;
+        Ok(())
+    }
+
+    pub fn add_point_light(&mut self, position: Vec3, intensity: Vec3, spot: Option<SpotCone>) -> Result<(), SceneError> {
+        check_emission("point light", intensity)?;
+        if !position.is_finite() {
+            return Err(SceneError::BadLight { what: "point".into(), message: format!("position {position:?}") });
+        }
+        if spot.is_some() {
+            self.stats.spot_lights += 1;
+        } else {
+            self.stats.point_lights += 1;
+        }
+        self.lights.push(Light { shape: LightShape::Point { position }, emission: intensity, texture: None, mean_emission: intensity, two_sided: false, spot });
+        Ok(())
+    }
+
+    pub fn add_distant_light(&mut self, direction_to_light: Vec3, irradiance: Vec3) -> Result<(), SceneError> {
+        check_emission("directional light", irradiance)?;
+        let d = direction_to_light.normalize_or_zero();
+        if d == Vec3::ZERO || !d.is_finite() {
+            return Err(SceneError::BadLight { what: "directional".into(), message: "zero direction".into() });
+        }
+        self.distant.push(DistantLight { direction: d, irradiance });
+        self.stats.distant_lights += 1;
+        Ok(())
+    }
+
+    pub fn add_camera(&mut self, camera: Camera) {
+        self.cameras.push(camera);
+    }
+
+    pub fn build(mut self) -> Result<Scene, SceneError> {
+        if self.triangles.is_empty() && self.lights.is_empty() {
+            return Err(SceneError::Empty);
+        }
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let mut prims: Vec<Primitive> = Vec::with_capacity(self.triangles.len() + self.spheres.len());
+        for t in &self.triangles {
+            for p in t.p {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            prims.push(Primitive::Triangle { v0: t.p[0], v1: t.p[1], v2: t.p[2] });
+        }
+        for &l in &self.spheres {
+            if let LightShape::Sphere { center, radius } = self.lights[l as usize].shape {
+                prims.push(Primitive::Sphere { center, radius });
+            }
+        }
+        for l in &self.lights {
+            let (a, b) = l.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+        self.stats.triangles = self.triangles.len();
+        self.stats.total_power_w = self.lights.iter().map(|l| l.power() as f64).sum();
+        let accel = Accel::build(&prims);
+        Ok(Scene {
+            name: self.name,
+            triangles: self.triangles,
+            materials: self.materials,
+            lights: self.lights,
+            sphere_prims: self.spheres,
+            distant_lights: self.distant,
+            cameras: self.cameras,
+            bounds: (lo, hi),
+            stats: self.stats,
+            accel,
+        })
+    }
+}
+
+/// Shared handle: scenes are immutable once built.
+pub type SceneRef = Arc<Scene>;
