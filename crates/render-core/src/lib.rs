@@ -8,6 +8,7 @@
 pub mod accel;
 pub mod bsdf;
 pub mod camera;
+pub mod chi2;
 pub mod error;
 pub mod estimator;
 pub mod frame;

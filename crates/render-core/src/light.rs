@@ -227,3 +227,106 @@ pub struct DistantLight {
     pub direction: Vec3,
     pub irradiance: Vec3,
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::chi2::{chi2_directions, sidak_significance};
+    use crate::rng::SampleStream;
+
+    fn sphere(center: Vec3, radius: f32) -> Light {
+        Light { shape: LightShape::Sphere { center, radius }, emission: Vec3::ONE, texture: None, mean_emission: Vec3::ONE, two_sided: false, spot: None }
+    }
+
+    fn triangle(p: [Vec3; 3], two_sided: bool) -> Light {
+        let c = (p[1] - p[0]).cross(p[2] - p[0]);
+        Light {
+            shape: LightShape::Triangle { p, normal: c.normalize(), area: 0.5 * c.length(), uv: [Vec2::ZERO; 3] },
+            emission: Vec3::ONE,
+            texture: None,
+            mean_emission: Vec3::ONE,
+            two_sided,
+            spot: None,
+        }
+    }
+
+    fn check(light: &Light, x: Vec3, seed: u64, sig: f64) {
+        let out = chi2_directions(
+            100_000,
+            40,
+            80,
+            8,
+            |i| {
+                let mut r = SampleStream::new(seed, i as u64, 0);
+                light.sample(x, r.next_2d()).map(|s| s.wi)
+            },
+            |w| {
+                // density of the direction w: the point it reaches on the light
+                match &light.shape {
+                    LightShape::Sphere { center, radius } => {
+                        let omc = crate::sampling::sphere_cone_one_minus_cos(*radius, (*center - x).length());
+                        let axis = (*center - x).normalize();
+                        if 1.0 - axis.dot(w) <= omc { light.pdf(x, Vec3::ZERO, Vec3::ZERO) as f64 } else { 0.0 }
+                    }
+                    LightShape::Triangle { p, normal, .. } => {
+                        let t = (p[0] - x).dot(*normal) / w.dot(*normal);
+                        let y = x + w * t;
+                        let inside = |a: Vec3, b: Vec3| (b - a).cross(y - a).dot(*normal) >= 0.0;
+                        if t > 0.0 && inside(p[0], p[1]) && inside(p[1], p[2]) && inside(p[2], p[0]) {
+                            light.pdf(x, y, *normal) as f64
+                        } else {
+                            0.0
+                        }
+                    }
+                    LightShape::Point { .. } => 0.0,
+                }
+            },
+        );
+        assert!(out.p_value > sig, "{out:?}");
+    }
+
+    #[test]
+    fn sphere_cap_and_triangle_sampling_match_their_pdfs() {
+        let sig = sidak_significance(0.01, 4);
+        check(&sphere(Vec3::new(0.3, 0.2, 2.0), 1.0), Vec3::ZERO, 1, sig);
+        check(&sphere(Vec3::new(-1.0, 0.5, 0.4), 0.4), Vec3::ZERO, 2, sig);
+        check(&triangle([Vec3::new(-1.0, -1.0, 1.0), Vec3::new(2.0, -0.5, 1.5), Vec3::new(0.0, 1.5, 0.8)], false), Vec3::ZERO, 3, sig);
+        // seen from behind: a two-sided triangle still emits
+        check(&triangle([Vec3::new(-1.0, -1.0, 1.0), Vec3::new(0.0, 1.5, 0.8), Vec3::new(2.0, -0.5, 1.5)], true), Vec3::ZERO, 4, sig);
+    }
+
+    #[test]
+    fn sampled_pdf_equals_evaluated_pdf() {
+        let lights = [sphere(Vec3::new(0.0, 0.0, 10.0), 0.001), triangle([Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(1.0, 0.0, 1.0)], false)];
+        for l in &lights {
+            let mut r = SampleStream::new(5, 0, 0);
+            for _ in 0..100 {
+                let s = l.sample(Vec3::ZERO, r.next_2d()).expect("faces the origin");
+                let p = l.pdf(Vec3::ZERO, s.point, s.normal);
+                assert!((p - s.pdf).abs() <= 1e-4 * s.pdf, "{p} vs {}", s.pdf);
+                assert!((s.point.length() - s.dist).abs() < 1e-4 * s.dist);
+            }
+        }
+    }
+
+    #[test]
+    fn tiny_sphere_points_lie_on_the_sphere() {
+        let l = sphere(Vec3::new(0.0, 0.0, 5.0), 0.001);
+        let mut r = SampleStream::new(6, 0, 0);
+        for _ in 0..100 {
+            let s = l.sample(Vec3::ZERO, r.next_2d()).unwrap();
+            let d = (s.point - Vec3::new(0.0, 0.0, 5.0)).length();
+            assert!((d - 0.001).abs() < 2e-5, "{d}");
+            assert!(s.normal.dot(-s.wi) > -1e-3, "visible side");
+        }
+    }
+
+    #[test]
+    fn one_sided_triangle_is_dark_from_behind() {
+        let l = triangle([Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)], false);
+        // normal +z, the origin is behind it
+        let mut r = SampleStream::new(7, 0, 0);
+        assert!((0..50).all(|_| l.sample(Vec3::ZERO, r.next_2d()).is_none()));
+        assert_eq!(l.pdf(Vec3::ZERO, Vec3::new(0.2, 0.2, 1.0), Vec3::Z), 0.0);
+    }
+}
