@@ -40,7 +40,12 @@ impl Bsdf {
         if !ns.is_finite() || ns.length_squared() < 0.5 {
             ns = ng;
         }
-        Bsdf { frame: Frame::from_normal_and_direction(ns, wo), ng, params, ggx: Ggx::new(params.alpha) }
+        Bsdf {
+            frame: Frame::from_normal_and_direction(ns, wo),
+            ng,
+            params,
+            ggx: Ggx::new(params.alpha),
+        }
     }
 
     /// True when the specular lobe is absent (the paper skips BRDF-oriented sampling there).
@@ -125,7 +130,11 @@ impl Bsdf {
         if pdf <= 0.0 {
             return None;
         }
-        Some(BsdfSample { wi, f_cos: self.eval_cos(wo, wi), pdf })
+        Some(BsdfSample {
+            wi,
+            f_cos: self.eval_cos(wo, wi),
+            pdf,
+        })
     }
 }
 
@@ -136,14 +145,24 @@ mod tests {
     use crate::rng::SampleStream;
 
     fn bsdf(alpha: f32, diffuse: f32, f0: f32, wo: Vec3) -> Bsdf {
-        let params = BsdfParams { diffuse: Vec3::splat(diffuse), f0: Vec3::splat(f0), alpha };
+        let params = BsdfParams {
+            diffuse: Vec3::splat(diffuse),
+            f0: Vec3::splat(f0),
+            alpha,
+        };
         Bsdf::new(Vec3::Z, Vec3::Z, wo, params)
     }
 
     /// Every sampled direction's density matches `pdf` (chi-square), for glossy, mixed and diffuse lobes.
     #[test]
     fn sampling_matches_pdf_chi2() {
-        let cases = [(0.05, 0.0, 1.0, 0.3), (0.2, 0.5, 0.04, 1.0), (0.6, 0.3, 0.5, 0.1), (1.0, 0.8, 0.0, 0.7), (0.1, 0.2, 0.04, 1.45)];
+        let cases = [
+            (0.05, 0.0, 1.0, 0.3),
+            (0.2, 0.5, 0.04, 1.0),
+            (0.6, 0.3, 0.5, 0.1),
+            (1.0, 0.8, 0.0, 0.7),
+            (0.1, 0.2, 0.04, 1.45),
+        ];
         let alpha_sig = sidak_significance(0.01, cases.len());
         for (k, &(alpha, kd, f0, theta)) in cases.iter().enumerate() {
             let wo = Vec3::new((theta as f32).sin(), 0.0, (theta as f32).cos());
@@ -159,7 +178,10 @@ mod tests {
                 },
                 |w| b.pdf(wo, w) as f64,
             );
-            assert!(out.p_value > alpha_sig, "case {k} (α={alpha}, θo={theta}): {out:?}");
+            assert!(
+                out.p_value > alpha_sig,
+                "case {k} (α={alpha}, θo={theta}): {out:?}"
+            );
         }
     }
 
@@ -191,6 +213,10 @@ mod tests {
                 sum += (s.f_cos.x / s.pdf) as f64;
             }
         }
-        assert!((sum / n as f64 - 0.7).abs() < 1e-4, "cosine sampling of Lambert is exact: {}", sum / n as f64);
+        assert!(
+            (sum / n as f64 - 0.7).abs() < 1e-4,
+            "cosine sampling of Lambert is exact: {}",
+            sum / n as f64
+        );
     }
 }

@@ -17,10 +17,26 @@ pub struct Camera {
 }
 
 impl Camera {
-    pub fn look_at(name: &str, eye: Vec3, target: Vec3, up: Vec3, yfov: f32, width: u32, height: u32) -> Camera {
+    pub fn look_at(
+        name: &str,
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        yfov: f32,
+        width: u32,
+        height: u32,
+    ) -> Camera {
         let forward = (target - eye).normalize();
         let right = forward.cross(up).normalize();
-        Camera { name: name.to_string(), position: eye, forward, up: right.cross(forward), yfov, width, height }
+        Camera {
+            name: name.to_string(),
+            position: eye,
+            forward,
+            up: right.cross(forward),
+            yfov,
+            width,
+            height,
+        }
     }
 
     /// A camera framing an axis-aligned box from the front-upper side (used when a glTF file has none).
@@ -30,7 +46,15 @@ impl Camera {
         let yfov = 45f32.to_radians();
         let dist = radius / (0.5 * yfov).sin() * 1.05;
         let dir = Vec3::new(0.0, 0.35, 1.0).normalize();
-        Camera::look_at("default", center + dir * dist, center, Vec3::Y, yfov, width, height)
+        Camera::look_at(
+            "default",
+            center + dir * dist,
+            center,
+            Vec3::Y,
+            yfov,
+            width,
+            height,
+        )
     }
 
     /// World ray through film position `film` in [0,1]² (x right, y down) for an image of the given aspect.

@@ -27,10 +27,20 @@ pub fn chi2_test(observed: &[f64], expected: &[f64]) -> Chi2Outcome {
     // edge of a cap); their samples join the pooled bin, but more than 0.1 % of all samples
     // there means the sampler covers what the density excludes.
     let total_observed: f64 = observed.iter().sum();
-    let stray: f64 = observed.iter().zip(expected).filter(|(_, e)| **e == 0.0).map(|(o, _)| *o).sum();
+    let stray: f64 = observed
+        .iter()
+        .zip(expected)
+        .filter(|(_, e)| **e == 0.0)
+        .map(|(o, _)| *o)
+        .sum();
     if stray > 1e-3 * total_observed.max(1.0) {
         message = format!("{stray} samples in bins where the density integrates to 0");
-        return Chi2Outcome { statistic: f64::INFINITY, dof: 0, p_value: 0.0, message };
+        return Chi2Outcome {
+            statistic: f64::INFINITY,
+            dof: 0,
+            p_value: 0.0,
+            message,
+        };
     }
     for &i in &order {
         let (o, e) = (observed[i], expected[i]);
@@ -54,7 +64,12 @@ pub fn chi2_test(observed: &[f64], expected: &[f64]) -> Chi2Outcome {
     }
     let dof = bins.saturating_sub(1).max(1);
     let p = gamma_q(dof as f64 / 2.0, stat / 2.0);
-    Chi2Outcome { statistic: stat, dof, p_value: p, message }
+    Chi2Outcome {
+        statistic: stat,
+        dof,
+        p_value: p,
+        message,
+    }
 }
 
 /// The significance for one of `tests` tests so that the family rejects a correct sampler
@@ -176,10 +191,16 @@ pub fn chi2_directions(
                 let (mut acc, mut zeros) = (0.0, 0usize);
                 for i in 0..sub {
                     for j in 0..sub {
-                        let c = 1.0 - 2.0 * (t as f64 + (i as f64 + 0.5) / sub as f64) / res_theta as f64;
-                        let phi = 2.0 * PI * (p as f64 + (j as f64 + 0.5) / sub as f64) / res_phi as f64;
+                        let c = 1.0
+                            - 2.0 * (t as f64 + (i as f64 + 0.5) / sub as f64) / res_theta as f64;
+                        let phi =
+                            2.0 * PI * (p as f64 + (j as f64 + 0.5) / sub as f64) / res_phi as f64;
                         let s = (1.0 - c * c).max(0.0).sqrt();
-                        let w = glam::Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, c as f32);
+                        let w = glam::Vec3::new(
+                            (s * phi.cos()) as f32,
+                            (s * phi.sin()) as f32,
+                            c as f32,
+                        );
                         let v = pdf(w);
                         zeros += (v == 0.0) as usize;
                         acc += v;
@@ -221,12 +242,24 @@ mod tests {
         // Uniform samples on the sphere tested against a cosine-weighted hemisphere pdf.
         let mut k = 0u64;
         let mut next = || {
-            k = k.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            k = k
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (k >> 40) as f32 / (1u64 << 24) as f32
         };
-        let out = chi2_directions(20_000, 10, 20, 4, |_| Some(crate::sampling::uniform_sphere(glam::Vec2::new(next(), next()))), |w| {
-            (w.z.max(0.0) as f64) / std::f64::consts::PI
-        });
+        let out = chi2_directions(
+            20_000,
+            10,
+            20,
+            4,
+            |_| {
+                Some(crate::sampling::uniform_sphere(glam::Vec2::new(
+                    next(),
+                    next(),
+                )))
+            },
+            |w| (w.z.max(0.0) as f64) / std::f64::consts::PI,
+        );
         assert!(out.p_value < 1e-6, "{out:?}");
     }
 }

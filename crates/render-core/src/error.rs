@@ -20,5 +20,9 @@ pub enum SceneError {
     #[error("unknown built-in scene `{name}` (known: {known})")]
     UnknownBuiltin { name: String, known: String },
     #[error("bad parameter `{key}` for built-in scene `{scene}`: {message}")]
-    BadBuiltinParam { scene: String, key: String, message: String },
+    BadBuiltinParam {
+        scene: String,
+        key: String,
+        message: String,
+    },
 }

@@ -39,7 +39,11 @@ impl ShadingPoint {
         }
         counters.shadow_rays += 1;
         let o = self.origin_towards(s.wi);
-        if scene.occluded(o, s.wi, (s.point - o).length()) { Vec3::ZERO } else { f }
+        if scene.occluded(o, s.wi, (s.point - o).length()) {
+            Vec3::ZERO
+        } else {
+            f
+        }
     }
 }
 
@@ -71,5 +75,11 @@ pub trait DirectLighting: Send + Sync {
     }
     /// An unbiased (unless documented otherwise) estimate of the radiance reflected towards
     /// `sp.wo` from the scene's bounded lights.
-    fn estimate(&self, scene: &Scene, sp: &ShadingPoint, rng: &mut SampleStream, ctx: &mut SampleContext) -> Vec3;
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Vec3;
 }

@@ -28,7 +28,11 @@ impl Frame {
             return Frame::from_normal(n);
         }
         let x = t / len2.sqrt();
-        Frame { x, y: n.cross(x), z: n }
+        Frame {
+            x,
+            y: n.cross(x),
+            z: n,
+        }
     }
 
     #[inline]
@@ -48,7 +52,12 @@ mod tests {
 
     #[test]
     fn frames_are_orthonormal_and_round_trip() {
-        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.5, 0.81).normalize()] {
+        for n in [
+            Vec3::Z,
+            -Vec3::Z,
+            Vec3::X,
+            Vec3::new(0.3, -0.5, 0.81).normalize(),
+        ] {
             let f = Frame::from_normal(n);
             assert!((f.x.dot(f.y)).abs() < 1e-6 && (f.x.dot(f.z)).abs() < 1e-6);
             assert!((f.x.cross(f.y) - f.z).length() < 1e-5, "right-handed");

@@ -12,9 +12,19 @@ use std::sync::Arc;
 #[derive(Clone, Debug)]
 pub enum LightShape {
     /// Vertices counter-clockwise around `normal`; `uv` only matters with an emission texture.
-    Triangle { p: [Vec3; 3], normal: Vec3, area: f32, uv: [Vec2; 3] },
-    Sphere { center: Vec3, radius: f32 },
-    Point { position: Vec3 },
+    Triangle {
+        p: [Vec3; 3],
+        normal: Vec3,
+        area: f32,
+        uv: [Vec2; 3],
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    Point {
+        position: Vec3,
+    },
 }
 
 /// Angular falloff of a spot light (glTF: smooth between inner and outer cone).
@@ -83,7 +93,9 @@ impl Light {
     pub fn power(&self) -> f32 {
         let l = luminance(self.mean_emission).max(0.0);
         match &self.shape {
-            LightShape::Triangle { area, .. } => l * area * if self.two_sided { 2.0 * PI } else { PI },
+            LightShape::Triangle { area, .. } => {
+                l * area * if self.two_sided { 2.0 * PI } else { PI }
+            }
             LightShape::Sphere { radius, .. } => l * PI * 4.0 * PI * radius * radius,
             LightShape::Point { .. } => 4.0 * PI * l,
         }
@@ -93,7 +105,9 @@ impl Light {
     pub fn bounds(&self) -> (Vec3, Vec3) {
         match &self.shape {
             LightShape::Triangle { p, .. } => (p[0].min(p[1]).min(p[2]), p[0].max(p[1]).max(p[2])),
-            LightShape::Sphere { center, radius } => (center - Vec3::splat(*radius), center + Vec3::splat(*radius)),
+            LightShape::Sphere { center, radius } => {
+                (center - Vec3::splat(*radius), center + Vec3::splat(*radius))
+            }
             LightShape::Point { position } => (*position, *position),
         }
     }
@@ -139,7 +153,12 @@ impl Light {
     /// or the sampled point emits nothing towards `x`.
     pub fn sample(&self, x: Vec3, u: Vec2) -> Option<LightSample> {
         match &self.shape {
-            LightShape::Triangle { p, normal, area, uv } => {
+            LightShape::Triangle {
+                p,
+                normal,
+                area,
+                uv,
+            } => {
                 let b = sampling::uniform_triangle(u);
                 let point = p[0] * (1.0 - b.x - b.y) + p[1] * b.x + p[2] * b.y;
                 let d = point - x;
@@ -155,7 +174,15 @@ impl Light {
                 if radiance == Vec3::ZERO {
                     return None;
                 }
-                Some(LightSample { point, normal: *normal, wi, dist, radiance, pdf: dist2 / (area * cos_l.abs()), is_delta: false })
+                Some(LightSample {
+                    point,
+                    normal: *normal,
+                    wi,
+                    dist,
+                    radiance,
+                    pdf: dist2 / (area * cos_l.abs()),
+                    is_delta: false,
+                })
             }
             LightShape::Sphere { center, radius } => {
                 let d = *center - x;
@@ -169,14 +196,24 @@ impl Light {
                 let wi = Frame::from_normal(axis).to_world(local).normalize();
                 let sin2 = local.x * local.x + local.y * local.y;
                 let cos_t = local.z;
-                let t = (dist_c * cos_t - (radius * radius - dist_c * dist_c * sin2).max(0.0).sqrt()).max(0.0);
+                let t = (dist_c * cos_t
+                    - (radius * radius - dist_c * dist_c * sin2).max(0.0).sqrt())
+                .max(0.0);
                 let point = x + wi * t;
                 let normal = (point - *center).normalize_or(-axis);
                 let radiance = self.emitted(normal, Vec2::ZERO, -wi);
                 if radiance == Vec3::ZERO {
                     return None;
                 }
-                Some(LightSample { point, normal, wi, dist: t, radiance, pdf: sampling::uniform_cone_pdf(omc), is_delta: false })
+                Some(LightSample {
+                    point,
+                    normal,
+                    wi,
+                    dist: t,
+                    radiance,
+                    pdf: sampling::uniform_cone_pdf(omc),
+                    is_delta: false,
+                })
             }
             LightShape::Point { position } => {
                 let d = *position - x;
@@ -190,7 +227,15 @@ impl Light {
                 if radiance == Vec3::ZERO {
                     return None;
                 }
-                Some(LightSample { point: *position, normal: Vec3::ZERO, wi, dist, radiance, pdf: 1.0, is_delta: true })
+                Some(LightSample {
+                    point: *position,
+                    normal: Vec3::ZERO,
+                    wi,
+                    dist,
+                    radiance,
+                    pdf: 1.0,
+                    is_delta: true,
+                })
             }
         }
     }
@@ -235,13 +280,25 @@ mod tests {
     use crate::rng::SampleStream;
 
     fn sphere(center: Vec3, radius: f32) -> Light {
-        Light { shape: LightShape::Sphere { center, radius }, emission: Vec3::ONE, texture: None, mean_emission: Vec3::ONE, two_sided: false, spot: None }
+        Light {
+            shape: LightShape::Sphere { center, radius },
+            emission: Vec3::ONE,
+            texture: None,
+            mean_emission: Vec3::ONE,
+            two_sided: false,
+            spot: None,
+        }
     }
 
     fn triangle(p: [Vec3; 3], two_sided: bool) -> Light {
         let c = (p[1] - p[0]).cross(p[2] - p[0]);
         Light {
-            shape: LightShape::Triangle { p, normal: c.normalize(), area: 0.5 * c.length(), uv: [Vec2::ZERO; 3] },
+            shape: LightShape::Triangle {
+                p,
+                normal: c.normalize(),
+                area: 0.5 * c.length(),
+                uv: [Vec2::ZERO; 3],
+            },
             emission: Vec3::ONE,
             texture: None,
             mean_emission: Vec3::ONE,
@@ -264,15 +321,23 @@ mod tests {
                 // density of the direction w: the point it reaches on the light
                 match &light.shape {
                     LightShape::Sphere { center, radius } => {
-                        let omc = crate::sampling::sphere_cone_one_minus_cos(*radius, (*center - x).length());
+                        let omc = crate::sampling::sphere_cone_one_minus_cos(
+                            *radius,
+                            (*center - x).length(),
+                        );
                         let axis = (*center - x).normalize();
-                        if 1.0 - axis.dot(w) <= omc { light.pdf(x, Vec3::ZERO, Vec3::ZERO) as f64 } else { 0.0 }
+                        if 1.0 - axis.dot(w) <= omc {
+                            light.pdf(x, Vec3::ZERO, Vec3::ZERO) as f64
+                        } else {
+                            0.0
+                        }
                     }
                     LightShape::Triangle { p, normal, .. } => {
                         let t = (p[0] - x).dot(*normal) / w.dot(*normal);
                         let y = x + w * t;
                         let inside = |a: Vec3, b: Vec3| (b - a).cross(y - a).dot(*normal) >= 0.0;
-                        if t > 0.0 && inside(p[0], p[1]) && inside(p[1], p[2]) && inside(p[2], p[0]) {
+                        if t > 0.0 && inside(p[0], p[1]) && inside(p[1], p[2]) && inside(p[2], p[0])
+                        {
                             light.pdf(x, y, *normal) as f64
                         } else {
                             0.0
@@ -290,14 +355,48 @@ mod tests {
         let sig = sidak_significance(0.01, 4);
         check(&sphere(Vec3::new(0.3, 0.2, 2.0), 1.0), Vec3::ZERO, 1, sig);
         check(&sphere(Vec3::new(-1.0, 0.5, 0.4), 0.4), Vec3::ZERO, 2, sig);
-        check(&triangle([Vec3::new(-1.0, -1.0, 1.0), Vec3::new(2.0, -0.5, 1.5), Vec3::new(0.0, 1.5, 0.8)], false), Vec3::ZERO, 3, sig);
+        check(
+            &triangle(
+                [
+                    Vec3::new(-1.0, -1.0, 1.0),
+                    Vec3::new(2.0, -0.5, 1.5),
+                    Vec3::new(0.0, 1.5, 0.8),
+                ],
+                false,
+            ),
+            Vec3::ZERO,
+            3,
+            sig,
+        );
         // seen from behind: a two-sided triangle still emits
-        check(&triangle([Vec3::new(-1.0, -1.0, 1.0), Vec3::new(0.0, 1.5, 0.8), Vec3::new(2.0, -0.5, 1.5)], true), Vec3::ZERO, 4, sig);
+        check(
+            &triangle(
+                [
+                    Vec3::new(-1.0, -1.0, 1.0),
+                    Vec3::new(0.0, 1.5, 0.8),
+                    Vec3::new(2.0, -0.5, 1.5),
+                ],
+                true,
+            ),
+            Vec3::ZERO,
+            4,
+            sig,
+        );
     }
 
     #[test]
     fn sampled_pdf_equals_evaluated_pdf() {
-        let lights = [sphere(Vec3::new(0.0, 0.0, 10.0), 0.001), triangle([Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0), Vec3::new(1.0, 0.0, 1.0)], false)];
+        let lights = [
+            sphere(Vec3::new(0.0, 0.0, 10.0), 0.001),
+            triangle(
+                [
+                    Vec3::new(0.0, 0.0, 1.0),
+                    Vec3::new(0.0, 1.0, 1.0),
+                    Vec3::new(1.0, 0.0, 1.0),
+                ],
+                false,
+            ),
+        ];
         for l in &lights {
             let mut r = SampleStream::new(5, 0, 0);
             for _ in 0..100 {
@@ -323,7 +422,14 @@ mod tests {
 
     #[test]
     fn one_sided_triangle_is_dark_from_behind() {
-        let l = triangle([Vec3::new(0.0, 0.0, 1.0), Vec3::new(1.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0)], false);
+        let l = triangle(
+            [
+                Vec3::new(0.0, 0.0, 1.0),
+                Vec3::new(1.0, 0.0, 1.0),
+                Vec3::new(0.0, 1.0, 1.0),
+            ],
+            false,
+        );
         // normal +z, the origin is behind it
         let mut r = SampleStream::new(7, 0, 0);
         assert!((0..50).all(|_| l.sample(Vec3::ZERO, r.next_2d()).is_none()));

@@ -55,12 +55,21 @@ pub struct BsdfParams {
 impl Material {
     /// A glossy or diffuse material with plain factors (used by the built-in scenes).
     pub fn simple(name: &str, base_color: Vec3, metallic: f32, roughness: f32) -> Material {
-        Material { name: name.into(), base_color, metallic, roughness, ..Default::default() }
+        Material {
+            name: name.into(),
+            base_color,
+            metallic,
+            roughness,
+            ..Default::default()
+        }
     }
 
     /// Lambert only: no specular lobe.
     pub fn diffuse(name: &str, base_color: Vec3) -> Material {
-        Material { specular: 0.0, ..Material::simple(name, base_color, 0.0, 1.0) }
+        Material {
+            specular: 0.0,
+            ..Material::simple(name, base_color, 0.0, 1.0)
+        }
     }
 
     pub fn params_at(&self, uv: Vec2) -> BsdfParams {
@@ -77,7 +86,11 @@ impl Material {
         let metallic = metallic.clamp(0.0, 1.0);
         let diffuse = base * (1.0 - metallic);
         let f0 = Vec3::splat(0.04 * self.specular.max(0.0)).lerp(base, metallic);
-        BsdfParams { diffuse, f0, alpha: (roughness * roughness).clamp(MIN_ALPHA, 1.0) }
+        BsdfParams {
+            diffuse,
+            f0,
+            alpha: (roughness * roughness).clamp(MIN_ALPHA, 1.0),
+        }
     }
 
     pub fn emission_at(&self, uv: Vec2) -> Vec3 {

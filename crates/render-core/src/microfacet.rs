@@ -13,7 +13,9 @@ pub struct Ggx {
 
 impl Ggx {
     pub fn new(alpha: f32) -> Ggx {
-        Ggx { alpha: alpha.clamp(MIN_ALPHA, 1.0) }
+        Ggx {
+            alpha: alpha.clamp(MIN_ALPHA, 1.0),
+        }
     }
 
     /// Normal distribution D(h).
@@ -60,7 +62,11 @@ impl Ggx {
         let a = self.alpha;
         let vh = Vec3::new(a * wo.x, a * wo.y, wo.z).normalize();
         let lensq = vh.x * vh.x + vh.y * vh.y;
-        let t1 = if lensq > 0.0 { Vec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt() } else { Vec3::X };
+        let t1 = if lensq > 0.0 {
+            Vec3::new(-vh.y, vh.x, 0.0) / lensq.sqrt()
+        } else {
+            Vec3::X
+        };
         let t2 = vh.cross(t1);
         let r = u.x.sqrt();
         let phi = 2.0 * PI * u.y;

@@ -5,13 +5,22 @@ use glam::Vec3;
 use std::path::{Path, PathBuf};
 
 fn temp_path(path: &Path) -> PathBuf {
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
-    let ext = path.extension().map(|e| e.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = path
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
     path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()))
 }
 
 /// Runs `write` on a temporary path beside `path`, then renames it to `path`.
-pub fn write_atomically(path: &Path, write: impl FnOnce(&Path) -> Result<(), String>) -> Result<(), String> {
+pub fn write_atomically(
+    path: &Path,
+    write: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), String> {
     let tmp = temp_path(path);
     match write(&tmp) {
         Ok(()) => std::fs::rename(&tmp, path).map_err(|e| {
@@ -42,21 +51,41 @@ pub fn read_exr(path: &Path) -> Result<(u32, u32, Vec<Vec3>), String> {
     let image = read_first_rgba_layer_from_file(
         path,
         |res, _| (res.width(), vec![Vec3::ZERO; res.width() * res.height()]),
-        |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b),
+        |(w, px), pos, (r, g, b, _a): (f32, f32, f32, f32)| {
+            px[pos.y() * *w + pos.x()] = Vec3::new(r, g, b)
+        },
     )
     .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let size = image.layer_data.size;
-    Ok((size.width() as u32, size.height() as u32, image.layer_data.channel_data.pixels.1))
+    Ok((
+        size.width() as u32,
+        size.height() as u32,
+        image.layer_data.channel_data.pixels.1,
+    ))
 }
 
 pub fn write_png_rgb8(path: &Path, width: u32, height: u32, rgb: &[u8]) -> Result<(), String> {
     write_atomically(path, |tmp| {
-        image::save_buffer_with_format(tmp, rgb, width, height, image::ColorType::Rgb8, image::ImageFormat::Png).map_err(|e| e.to_string())
+        image::save_buffer_with_format(
+            tmp,
+            rgb,
+            width,
+            height,
+            image::ColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| e.to_string())
     })
 }
 
 /// sRGB preview: linear × 2^exposure, clamped.
-pub fn write_png(path: &Path, width: u32, height: u32, pixels: &[Vec3], exposure: f32) -> Result<(), String> {
+pub fn write_png(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Vec3],
+    exposure: f32,
+) -> Result<(), String> {
     let scale = 2f32.powf(exposure);
     let rgb: Vec<u8> = pixels
         .iter()
@@ -68,7 +97,10 @@ pub fn write_png(path: &Path, width: u32, height: u32, pixels: &[Vec3], exposure
 
 /// Greyscale-as-RGB PNG of values in [0, 1].
 pub fn write_mask_png(path: &Path, width: u32, height: u32, values: &[f32]) -> Result<(), String> {
-    let rgb: Vec<u8> = values.iter().flat_map(|v| [(v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8; 3]).collect();
+    let rgb: Vec<u8> = values
+        .iter()
+        .flat_map(|v| [(v.clamp(0.0, 1.0) * 255.0 + 0.5) as u8; 3])
+        .collect();
     write_png_rgb8(path, width, height, &rgb)
 }
 

@@ -93,7 +93,11 @@ fn shade_camera_sample(
         return (l, sees_light);
     };
     let params = scene.materials[material as usize].params_at(hit.uv);
-    let sp = ShadingPoint { hit, wo, bsdf: Bsdf::new(hit.ns, hit.ng, wo, params) };
+    let sp = ShadingPoint {
+        hit,
+        wo,
+        bsdf: Bsdf::new(hit.ns, hit.ng, wo, params),
+    };
     ctx.counters.shading_points += 1;
     l += strategy.estimate(scene, &sp, rng, ctx);
     l += distant_lighting(scene, &sp, ctx);
@@ -109,7 +113,12 @@ fn distant_lighting(scene: &Scene, sp: &ShadingPoint, ctx: &mut SampleContext) -
             continue;
         }
         ctx.counters.shadow_rays += 1;
-        if !scene.accel.occluded(sp.origin_towards(d.direction), d.direction, 0.0, f32::INFINITY) {
+        if !scene.accel.occluded(
+            sp.origin_towards(d.direction),
+            d.direction,
+            0.0,
+            f32::INFINITY,
+        ) {
             l += f;
         }
     }
@@ -120,7 +129,11 @@ fn distant_lighting(scene: &Scene, sp: &ShadingPoint, ctx: &mut SampleContext) -
 pub fn shading_point(scene: &Scene, hit: SurfaceHit, wo: Vec3) -> Option<ShadingPoint> {
     let m = hit.material?;
     let params = scene.materials[m as usize].params_at(hit.uv);
-    Some(ShadingPoint { hit, wo, bsdf: Bsdf::new(hit.ns, hit.ng, wo, params) })
+    Some(ShadingPoint {
+        hit,
+        wo,
+        bsdf: Bsdf::new(hit.ns, hit.ng, wo, params),
+    })
 }
 
 /// Renders `scene` with `strategy`. `progress` is called after each pass with (passes done, spp so far).
@@ -176,9 +189,24 @@ pub fn render(
                         let (x, y) = (index % w, index / w);
                         let mut rng = SampleStream::new(settings.seed, index as u64, sample_index);
                         let jitter = rng.next_2d();
-                        let film = Vec2::new((x as f32 + jitter.x) / w as f32, (y as f32 + jitter.y) / h as f32);
-                        let mut ctx = SampleContext { counters: &mut c, aux: [0.0; MAX_AUX], pixel_memory: &mut px.memory };
-                        let (l, sees_light) = shade_camera_sample(scene, strategy, &settings.camera, aspect, film, &mut rng, &mut ctx);
+                        let film = Vec2::new(
+                            (x as f32 + jitter.x) / w as f32,
+                            (y as f32 + jitter.y) / h as f32,
+                        );
+                        let mut ctx = SampleContext {
+                            counters: &mut c,
+                            aux: [0.0; MAX_AUX],
+                            pixel_memory: &mut px.memory,
+                        };
+                        let (l, sees_light) = shade_camera_sample(
+                            scene,
+                            strategy,
+                            &settings.camera,
+                            aspect,
+                            film,
+                            &mut rng,
+                            &mut ctx,
+                        );
                         let aux = ctx.aux;
                         // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
                         for k in 0..3 {
@@ -203,7 +231,16 @@ pub fn render(
         progress(passes, spp_done);
     }
     let n = spp_done as f64;
-    let pixels = accum.iter().map(|p| Vec3::new((p.sum[0] / n) as f32, (p.sum[1] / n) as f32, (p.sum[2] / n) as f32)).collect();
+    let pixels = accum
+        .iter()
+        .map(|p| {
+            Vec3::new(
+                (p.sum[0] / n) as f32,
+                (p.sum[1] / n) as f32,
+                (p.sum[2] / n) as f32,
+            )
+        })
+        .collect();
     let variance_of_mean = accum
         .iter()
         .map(|p| {
@@ -217,18 +254,38 @@ pub fn render(
             Vec3::new(v(0), v(1), v(2))
         })
         .collect();
-    let light_fraction = accum.iter().map(|p| (p.light_hits as f64 / n) as f32).collect();
+    let light_fraction = accum
+        .iter()
+        .map(|p| (p.light_hits as f64 / n) as f32)
+        .collect();
     let aux = strategy
         .aux_channels()
         .iter()
         .take(n_aux)
         .enumerate()
-        .map(|(k, name)| (name.to_string(), accum.iter().map(|p| (p.aux[k] / n) as f32).collect()))
+        .map(|(k, name)| {
+            (
+                name.to_string(),
+                accum.iter().map(|p| (p.aux[k] / n) as f32).collect(),
+            )
+        })
         .collect();
     let wall_seconds = start.elapsed().as_secs_f64();
     let cpu_seconds = match (cpu_start, process_cpu_seconds()) {
         (Some(a), Some(b)) => Some(b - a),
         _ => None,
     };
-    Ok(RenderResult { width: settings.width, height: settings.height, spp: spp_done, pixels, variance_of_mean, light_fraction, aux, counters, wall_seconds, cpu_seconds, passes })
+    Ok(RenderResult {
+        width: settings.width,
+        height: settings.height,
+        spp: spp_done,
+        pixels,
+        variance_of_mean,
+        light_fraction,
+        aux,
+        counters,
+        wall_seconds,
+        cpu_seconds,
+        passes,
+    })
 }

@@ -19,7 +19,10 @@ fn mix64(mut z: u64) -> u64 {
 
 impl SampleStream {
     pub fn new(seed: u64, pixel: u64, sample_index: u64) -> SampleStream {
-        let key = mix64(mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel) ^ sample_index.wrapping_mul(0xd1b5_4a32_d192_ed03));
+        let key = mix64(
+            mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel)
+                ^ sample_index.wrapping_mul(0xd1b5_4a32_d192_ed03),
+        );
         SampleStream { key, dim: 0 }
     }
 

@@ -79,26 +79,49 @@ impl Scene {
             let ng = (tri.p[1] - tri.p[0]).cross(tri.p[2] - tri.p[0]).normalize();
             let ns = (tri.n[0] * b0 + tri.n[1] * hit.b1 + tri.n[2] * hit.b2).normalize_or(ng);
             let uv = tri.uv[0] * b0 + tri.uv[1] * hit.b1 + tri.uv[2] * hit.b2;
-            SurfaceHit { point, t: hit.t, ng, ns, uv, material: Some(tri.material), light: tri.light }
+            SurfaceHit {
+                point,
+                t: hit.t,
+                ng,
+                ns,
+                uv,
+                material: Some(tri.material),
+                light: tri.light,
+            }
         } else {
             let light = self.sphere_prims[(hit.prim - ntri) as usize];
             let LightShape::Sphere { center, .. } = self.lights[light as usize].shape else {
                 unreachable!("sphere primitives map to sphere lights")
             };
             let n = (point - center).normalize_or(-dir);
-            SurfaceHit { point, t: hit.t, ng: n, ns: n, uv: Vec2::ZERO, material: None, light }
+            SurfaceHit {
+                point,
+                t: hit.t,
+                ng: n,
+                ns: n,
+                uv: Vec2::ZERO,
+                material: None,
+                light,
+            }
         }
     }
 
     /// Closest surface along a ray.
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<SurfaceHit> {
-        self.accel.intersect(origin, dir, tmin, tmax).map(|h| self.surface(origin, dir, &h))
+        self.accel
+            .intersect(origin, dir, tmin, tmax)
+            .map(|h| self.surface(origin, dir, &h))
     }
 
     /// True when the segment from `origin` (already offset off its surface) along `dir` up to
     /// `dist` is blocked. The far end is shortened so the light's own surface never occludes.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, dist: f32) -> bool {
-        self.accel.occluded(origin, dir, 0.0, dist * (1.0 - 1e-4) - ray_epsilon(origin + dir * dist))
+        self.accel.occluded(
+            origin,
+            dir,
+            0.0,
+            dist * (1.0 - 1e-4) - ray_epsilon(origin + dir * dist),
+        )
     }
 
     /// Scene diagonal, a length scale for defaults.
@@ -108,8 +131,17 @@ impl Scene {
 
     pub fn camera(&self, name: Option<&str>) -> Result<Camera, SceneError> {
         match name {
-            Some(n) => self.cameras.iter().find(|c| c.name == n).cloned().ok_or_else(|| SceneError::CameraNotFound(n.into())),
-            None => Ok(self.cameras.first().cloned().unwrap_or_else(|| Camera::framing(self.bounds.0, self.bounds.1, 512, 512))),
+            Some(n) => self
+                .cameras
+                .iter()
+                .find(|c| c.name == n)
+                .cloned()
+                .ok_or_else(|| SceneError::CameraNotFound(n.into())),
+            None => Ok(self
+                .cameras
+                .first()
+                .cloned()
+                .unwrap_or_else(|| Camera::framing(self.bounds.0, self.bounds.1, 512, 512))),
         }
     }
 }
@@ -123,7 +155,11 @@ pub fn ray_epsilon(p: Vec3) -> f32 {
 /// Moves `p` off its surface towards the side `w` leaves through.
 pub fn offset_origin(p: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
     let e = ray_epsilon(p);
-    if ng.dot(w) >= 0.0 { p + ng * e } else { p - ng * e }
+    if ng.dot(w) >= 0.0 {
+        p + ng * e
+    } else {
+        p - ng * e
+    }
 }
 
 /// Collects geometry, materials and lights, validates them and builds a [`Scene`].
@@ -140,7 +176,10 @@ pub struct SceneBuilder {
 
 fn check_emission(what: &str, e: Vec3) -> Result<(), SceneError> {
     if !e.is_finite() || e.min_element() < 0.0 {
-        return Err(SceneError::BadEmission { what: what.into(), value: format!("{:?}", e.to_array()) });
+        return Err(SceneError::BadEmission {
+            what: what.into(),
+            value: format!("{:?}", e.to_array()),
+        });
     }
     Ok(())
 }
@@ -148,7 +187,8 @@ fn check_emission(what: &str, e: Vec3) -> Result<(), SceneError> {
 /// Mean of an emission texture over a triangle, by a stratified barycentric grid whose
 /// density follows the triangle's footprint in texels.
 fn mean_over_triangle(tex: &crate::texture::Texture, uv: [Vec2; 3]) -> Vec3 {
-    let texels = 0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs() * (tex.width * tex.height) as f32;
+    let texels =
+        0.5 * (uv[1] - uv[0]).perp_dot(uv[2] - uv[0]).abs() * (tex.width * tex.height) as f32;
     let n = (texels.sqrt() * 2.0).clamp(4.0, 64.0) as usize;
     let mut sum = Vec3::ZERO;
     let mut count = 0usize;
@@ -203,17 +243,29 @@ impl SceneBuilder {
         material: u32,
     ) -> Result<(), SceneError> {
         if positions.iter().any(|p| !p.is_finite()) || !transform.is_finite() {
-            return Err(SceneError::NonFiniteVertex { mesh: mesh_name.into() });
+            return Err(SceneError::NonFiniteVertex {
+                mesh: mesh_name.into(),
+            });
         }
         let normal_matrix = transform.inverse().transpose();
         let flips = transform.determinant() < 0.0;
-        let wp: Vec<Vec3> = positions.iter().map(|p| transform.transform_point3(*p)).collect();
-        let wn: Option<Vec<Vec3>> = normals.map(|ns| ns.iter().map(|n| normal_matrix.transform_vector3(*n).normalize_or_zero()).collect());
+        let wp: Vec<Vec3> = positions
+            .iter()
+            .map(|p| transform.transform_point3(*p))
+            .collect();
+        let wn: Option<Vec<Vec3>> = normals.map(|ns| {
+            ns.iter()
+                .map(|n| normal_matrix.transform_vector3(*n).normalize_or_zero())
+                .collect()
+        });
         let mat = self.materials[material as usize].clone();
         for (k, idx) in indices.chunks_exact(3).enumerate() {
             let (mut i0, i1, mut i2) = (idx[0] as usize, idx[1] as usize, idx[2] as usize);
             if [i0, i1, i2].iter().any(|&i| i >= wp.len()) {
-                return Err(SceneError::Gltf { path: mesh_name.into(), message: format!("triangle {k} indexes past the vertex array") });
+                return Err(SceneError::Gltf {
+                    path: mesh_name.into(),
+                    message: format!("triangle {k} indexes past the vertex array"),
+                });
             }
             if flips {
                 std::mem::swap(&mut i0, &mut i2); // keep counter-clockwise = front
@@ -227,7 +279,13 @@ impl SceneBuilder {
             }
             let ng = cross.normalize();
             let n = match &wn {
-                Some(wn) => [i0, i1, i2].map(|i| if wn[i] == Vec3::ZERO || !wn[i].is_finite() { ng } else { wn[i] }),
+                Some(wn) => [i0, i1, i2].map(|i| {
+                    if wn[i] == Vec3::ZERO || !wn[i].is_finite() {
+                        ng
+                    } else {
+                        wn[i]
+                    }
+                }),
                 None => [ng; 3],
             };
             let uv = match uvs {
@@ -243,7 +301,12 @@ impl SceneBuilder {
                 if mean.max_element() > 0.0 {
                     light = self.lights.len() as u32;
                     self.lights.push(Light {
-                        shape: LightShape::Triangle { p, normal: ng, area, uv },
+                        shape: LightShape::Triangle {
+                            p,
+                            normal: ng,
+                            area,
+                            uv,
+                        },
                         emission: mat.emission,
                         texture: mat.emission_texture.clone(),
                         mean_emission: mean,
@@ -255,44 +318,91 @@ impl SceneBuilder {
                     self.stats.black_emissive_triangles += 1;
                 }
             }
-            self.triangles.push(Triangle { p, n, uv, material, light });
+            self.triangles.push(Triangle {
+                p,
+                n,
+                uv,
+                material,
+                light,
+            });
         }
         Ok(())
     }
 
     /// A sphere light of radius `radius` > 0 and uniform radiance.
-    pub fn add_sphere_light(&mut self, center: Vec3, radius: f32, radiance: Vec3, spot: Option<SpotCone>) -> Result<(), SceneError> {
+    pub fn add_sphere_light(
+        &mut self,
+        center: Vec3,
+        radius: f32,
+        radiance: Vec3,
+        spot: Option<SpotCone>,
+    ) -> Result<(), SceneError> {
         check_emission("sphere light", radiance)?;
         if !center.is_finite() || !(radius > 0.0) || !radius.is_finite() {
-            return Err(SceneError::BadLight { what: "sphere".into(), message: format!("center {center:?}, radius {radius}") });
+            return Err(SceneError::BadLight {
+                what: "sphere".into(),
+                message: format!("center {center:?}, radius {radius}"),
+            });
         }
         self.spheres.push(self.lights.len() as u32);
-        self.lights.push(Light { shape: LightShape::Sphere { center, radius }, emission: radiance, texture: None, mean_emission: radiance, two_sided: false, spot });
+        self.lights.push(Light {
+            shape: LightShape::Sphere { center, radius },
+            emission: radiance,
+            texture: None,
+            mean_emission: radiance,
+            two_sided: false,
+            spot,
+        });
         self.stats.sphere_lights += 1;
         Ok(())
     }
 
-    pub fn add_point_light(&mut self, position: Vec3, intensity: Vec3, spot: Option<SpotCone>) -> Result<(), SceneError> {
+    pub fn add_point_light(
+        &mut self,
+        position: Vec3,
+        intensity: Vec3,
+        spot: Option<SpotCone>,
+    ) -> Result<(), SceneError> {
         check_emission("point light", intensity)?;
         if !position.is_finite() {
-            return Err(SceneError::BadLight { what: "point".into(), message: format!("position {position:?}") });
+            return Err(SceneError::BadLight {
+                what: "point".into(),
+                message: format!("position {position:?}"),
+            });
         }
         if spot.is_some() {
             self.stats.spot_lights += 1;
         } else {
             self.stats.point_lights += 1;
         }
-        self.lights.push(Light { shape: LightShape::Point { position }, emission: intensity, texture: None, mean_emission: intensity, two_sided: false, spot });
+        self.lights.push(Light {
+            shape: LightShape::Point { position },
+            emission: intensity,
+            texture: None,
+            mean_emission: intensity,
+            two_sided: false,
+            spot,
+        });
         Ok(())
     }
 
-    pub fn add_distant_light(&mut self, direction_to_light: Vec3, irradiance: Vec3) -> Result<(), SceneError> {
+    pub fn add_distant_light(
+        &mut self,
+        direction_to_light: Vec3,
+        irradiance: Vec3,
+    ) -> Result<(), SceneError> {
         check_emission("directional light", irradiance)?;
         let d = direction_to_light.normalize_or_zero();
         if d == Vec3::ZERO || !d.is_finite() {
-            return Err(SceneError::BadLight { what: "directional".into(), message: "zero direction".into() });
+            return Err(SceneError::BadLight {
+                what: "directional".into(),
+                message: "zero direction".into(),
+            });
         }
-        self.distant.push(DistantLight { direction: d, irradiance });
+        self.distant.push(DistantLight {
+            direction: d,
+            irradiance,
+        });
         self.stats.distant_lights += 1;
         Ok(())
     }
@@ -307,13 +417,18 @@ impl SceneBuilder {
         }
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        let mut prims: Vec<Primitive> = Vec::with_capacity(self.triangles.len() + self.spheres.len());
+        let mut prims: Vec<Primitive> =
+            Vec::with_capacity(self.triangles.len() + self.spheres.len());
         for t in &self.triangles {
             for p in t.p {
                 lo = lo.min(p);
                 hi = hi.max(p);
             }
-            prims.push(Primitive::Triangle { v0: t.p[0], v1: t.p[1], v2: t.p[2] });
+            prims.push(Primitive::Triangle {
+                v0: t.p[0],
+                v1: t.p[1],
+                v2: t.p[2],
+            });
         }
         for &l in &self.spheres {
             if let LightShape::Sphere { center, radius } = self.lights[l as usize].shape {

@@ -12,7 +12,11 @@ pub struct Texture {
 impl Texture {
     pub fn new(width: u32, height: u32, texels: Vec<Vec4>) -> Texture {
         assert_eq!(texels.len(), (width * height) as usize);
-        Texture { width, height, texels }
+        Texture {
+            width,
+            height,
+            texels,
+        }
     }
 
     fn texel(&self, x: i64, y: i64) -> Vec4 {
@@ -40,12 +44,20 @@ impl Texture {
 
 /// sRGB transfer function to linear.
 pub fn srgb_to_linear(c: f32) -> f32 {
-    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
 }
 
 pub fn linear_to_srgb(c: f32) -> f32 {
     let c = c.clamp(0.0, 1.0);
-    if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 }
+    if c <= 0.003_130_8 {
+        12.92 * c
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    }
 }
 
 #[cfg(test)]

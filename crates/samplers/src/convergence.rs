@@ -1,0 +1,73 @@
+//! Statistical comparison of renders, used by the tests that check every strategy converges
+//! to the same image: region means must agree within a number of standard errors.
+use render_core::Vec3;
+use render_core::render::RenderResult;
+
+fn luminance(c: Vec3) -> f64 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722)) as f64
+}
+
+/// Mean luminance over a pixel rectangle and the standard error of that mean, from the
+/// per-pixel variances of the render. Pixels whose camera ray sees a light are left out
+/// when `unlit_only` (their value is the light's radiance, the same for every strategy).
+pub fn region_mean(
+    r: &RenderResult,
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
+    unlit_only: bool,
+) -> (f64, f64) {
+    let (mut sum, mut var, mut n) = (0.0, 0.0, 0usize);
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let i = (y * r.width + x) as usize;
+            if unlit_only && r.light_fraction[i] > 0.0 {
+                continue;
+            }
+            sum += luminance(r.pixels[i]);
+            let v = r.variance_of_mean[i];
+            // Var of a weighted sum of channels, assuming channels perfectly correlated (conservative).
+            let sd = 0.2126 * (v.x as f64).sqrt()
+                + 0.7152 * (v.y as f64).sqrt()
+                + 0.0722 * (v.z as f64).sqrt();
+            var += sd * sd;
+            n += 1;
+        }
+    }
+    if n == 0 {
+        return (0.0, 0.0);
+    }
+    (sum / n as f64, var.sqrt() / n as f64)
+}
+
+/// Compares two renders over a grid of `cells × cells` regions plus the whole image.
+/// Returns a description of every region whose means differ by more than `z` combined
+/// standard errors.
+pub fn compare(a: &RenderResult, b: &RenderResult, cells: u32, z: f64) -> Vec<String> {
+    assert_eq!((a.width, a.height), (b.width, b.height));
+    let mut failures = Vec::new();
+    let mut regions = vec![(0, 0, a.width, a.height)];
+    for cy in 0..cells {
+        for cx in 0..cells {
+            regions.push((
+                cx * a.width / cells,
+                cy * a.height / cells,
+                (cx + 1) * a.width / cells,
+                (cy + 1) * a.height / cells,
+            ));
+        }
+    }
+    for (x0, y0, x1, y1) in regions {
+        let (ma, sa) = region_mean(a, x0, y0, x1, y1, true);
+        let (mb, sb) = region_mean(b, x0, y0, x1, y1, true);
+        let se = (sa * sa + sb * sb).sqrt();
+        if (ma - mb).abs() > z * se + 1e-6 * ma.abs().max(mb.abs()) {
+            failures.push(format!(
+                "region ({x0},{y0})-({x1},{y1}): {ma:.6} ± {sa:.6} vs {mb:.6} ± {sb:.6} ({:.1} SE)",
+                (ma - mb).abs() / se
+            ));
+        }
+    }
+    failures
+}

@@ -1,0 +1,110 @@
+//! Light sampling through a [`LightSelection`], optionally combined with BSDF sampling by
+//! MIS (power heuristic, one sample of each; a splitting selection counts as one sample).
+use crate::bsdf_sampling::sample_bsdf;
+use crate::mis::power2;
+use crate::selection::LightSelection;
+use render_core::Vec3;
+use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+
+pub struct LightStrategy<S: LightSelection> {
+    pub name: String,
+    pub selection: S,
+    pub with_bsdf: bool,
+    pub parameters: serde_json::Value,
+}
+
+pub const TECHNIQUE_LIGHT: usize = 0;
+pub const TECHNIQUE_BSDF: usize = 1;
+
+impl<S: LightSelection> DirectLighting for LightStrategy<S> {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        self.parameters.clone()
+    }
+
+    fn techniques(&self) -> Vec<&'static str> {
+        if self.with_bsdf {
+            vec!["light", "bsdf"]
+        } else {
+            vec!["light"]
+        }
+    }
+
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let state = self.selection.prepare(scene, sp);
+        let mut picks = Vec::new();
+        self.selection.pick(&state, sp, rng, &mut picks);
+        let x = sp.point();
+        let mut l = Vec3::ZERO;
+        for &(light, pmf) in &picks {
+            let u = rng.next_2d();
+            ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
+            let Some(s) = scene.lights[light as usize].sample(x, u) else {
+                continue;
+            };
+            let p_light = pmf * s.pdf;
+            if !(p_light > 0.0) {
+                continue;
+            }
+            let f = sp.shade(scene, &s, ctx.counters);
+            if f == Vec3::ZERO {
+                continue;
+            }
+            let w = if self.with_bsdf && !s.is_delta {
+                power2(p_light, sp.bsdf.pdf(sp.wo, s.wi))
+            } else {
+                1.0
+            };
+            l += f * (w / p_light);
+        }
+        if self.with_bsdf {
+            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
+            if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)
+                && b.found_light()
+            {
+                let p_light = self.selection.pmf(&state, sp, b.light)
+                    * scene.lights[b.light as usize].pdf(x, b.point, b.normal);
+                l += b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf);
+            }
+        }
+        l
+    }
+}
+
+/// BSDF sampling alone: complete for area and sphere lights, blind to delta lights.
+pub struct BsdfStrategy;
+
+impl DirectLighting for BsdfStrategy {
+    fn name(&self) -> String {
+        "bsdf".into()
+    }
+
+    fn techniques(&self) -> Vec<&'static str> {
+        vec!["bsdf"]
+    }
+
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        ctx.counters.technique_samples[0] += 1;
+        match sample_bsdf(scene, sp, rng, ctx.counters) {
+            Some(b) if b.found_light() => b.f_cos * b.radiance / b.pdf,
+            _ => Vec3::ZERO,
+        }
+    }
+}

@@ -1,0 +1,64 @@
+//! Every strategy converges to the same image, and images do not depend on the thread count.
+mod common;
+use render_core::render::{RenderResult, RenderSettings, render};
+use render_core::scene::Scene;
+use samplers::convergence::compare;
+use samplers::{StrategyOptions, create};
+
+fn render_with(scene: &Scene, name: &str, spp: u32, threads: usize, seed: u64) -> RenderResult {
+    let strategy = create(name, scene, &StrategyOptions::default()).unwrap();
+    let camera = scene.camera(None).unwrap();
+    let settings = RenderSettings {
+        width: camera.width,
+        height: camera.height,
+        spp: Some(spp),
+        seed,
+        time_budget: None,
+        threads: Some(threads),
+        camera,
+    };
+    render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
+}
+
+#[test]
+fn baseline_strategies_agree_on_a_mixed_scene() {
+    let scene = common::mixed_scene(40);
+    let reference = render_with(&scene, "power+bsdf", 256, 2, 1);
+    let (mean, se) = samplers::convergence::region_mean(
+        &reference,
+        0,
+        0,
+        reference.width,
+        reference.height,
+        true,
+    );
+    assert!(
+        mean > 0.01 && se < 0.01 * mean,
+        "the comparison must have power: {mean} ± {se}"
+    );
+    for (name, spp) in [("uniform", 256), ("power", 256), ("bsdf", 1024)] {
+        let r = render_with(&scene, name, spp, 2, 2);
+        let failures = compare(&reference, &r, 2, 3.0);
+        assert!(
+            failures.is_empty(),
+            "{name} vs power+bsdf:\n{}",
+            failures.join("\n")
+        );
+    }
+}
+
+#[test]
+fn image_is_identical_for_any_thread_count() {
+    let scene = common::mixed_scene(10);
+    let a = render_with(&scene, "power+bsdf", 4, 1, 7);
+    let b = render_with(&scene, "power+bsdf", 4, 2, 7);
+    assert!(
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits))
+    );
+    assert_eq!(a.counters, b.counters);
+    let c = render_with(&scene, "power+bsdf", 4, 2, 8);
+    assert!(a.pixels != c.pixels, "another seed gives another image");
+}
