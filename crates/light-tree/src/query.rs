@@ -1,0 +1,376 @@
+//! Queries: node importance, stochastic descent and its pmf replay, cuts.
+
+use crate::{LightTree, Node, NodeId};
+use glam::Vec3;
+use std::collections::VecDeque;
+
+/// Largest f32 below 1.
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+/// Floor of the squared distance in the importance: keeps Φ/d² finite when x sits exactly on
+/// a point light (r = 0).
+const MIN_DIST_SQ: f32 = 1e-12;
+/// Emitter cosine used where θ′ < θe but cos θ′ ≤ 0 (possible only for θe > π/2): keeps such
+/// emitters sampleable instead of giving them zero importance.
+const MIN_EMIT_COS: f32 = 1e-3;
+
+/// Source of the random decisions in a descent.
+pub trait DescentRandom {
+    /// Returns `true` (go left) with probability `p_left`, `0 < p_left < 1`.
+    fn go_left(&mut self, p_left: f32) -> bool;
+}
+
+/// One uniform number in [0, 1) rescaled at every level (E&K / pbrt-v4 style). Loses about
+/// one bit of precision per level.
+#[derive(Clone, Copy, Debug)]
+pub struct Rescaled(pub f32);
+
+impl DescentRandom for Rescaled {
+    #[inline]
+    fn go_left(&mut self, p_left: f32) -> bool {
+        let u = self.0;
+        if u < p_left {
+            self.0 = (u / p_left).min(ONE_MINUS_EPSILON);
+            true
+        } else {
+            self.0 = ((u - p_left) / (1.0 - p_left)).min(ONE_MINUS_EPSILON);
+            false
+        }
+    }
+}
+
+/// A fresh uniform number in [0, 1) per level (Liu et al.'s improvement), drawn from the
+/// wrapped closure.
+pub struct Fresh<F: FnMut() -> f32>(pub F);
+
+impl<F: FnMut() -> f32> DescentRandom for Fresh<F> {
+    #[inline]
+    fn go_left(&mut self, p_left: f32) -> bool {
+        (self.0)() < p_left
+    }
+}
+
+impl<R: DescentRandom + ?Sized> DescentRandom for &mut R {
+    #[inline]
+    fn go_left(&mut self, p_left: f32) -> bool {
+        (**self).go_left(p_left)
+    }
+}
+
+/// Importance as used by the descent: NaN and negative values count as 0, and values are
+/// capped at f32::MAX / 4 so that the sum of two stays finite.
+#[inline]
+fn sanitize(i: f32) -> f32 {
+    if i > 0.0 { i.min(f32::MAX / 4.0) } else { 0.0 }
+}
+
+/// cos(max(θa − θb, 0)) from cosines and sines, with θa, θb ∈ [0, π].
+#[inline]
+fn cos_sub_clamped(cos_a: f32, sin_a: f32, cos_b: f32, sin_b: f32) -> f32 {
+    if cos_a >= cos_b {
+        1.0
+    } else {
+        cos_a * cos_b + sin_a * sin_b
+    }
+}
+
+/// sin(max(θa − θb, 0)).
+#[inline]
+fn sin_sub_clamped(cos_a: f32, sin_a: f32, cos_b: f32, sin_b: f32) -> f32 {
+    if cos_a >= cos_b {
+        0.0
+    } else {
+        sin_a * cos_b - cos_a * sin_b
+    }
+}
+
+impl Node {
+    /// E&K importance of this node for a receiver at `x` with normal `n`; see
+    /// [`LightTree::importance`].
+    #[inline]
+    pub fn importance(&self, x: Vec3, n: Vec3) -> f32 {
+        let center = self.center();
+        let half = (self.aabb_max - self.aabb_min) * 0.5;
+        let to_c = center - x;
+        // Box–plane tests (conservative, monotone under the box union): the whole box behind
+        // the receiver's tangent plane, or the receiver behind the whole box of a one-sided
+        // emitter set whose emission stays within π/2 of the axis.
+        let has_n = n != Vec3::ZERO;
+        if has_n && n.dot(to_c) + n.abs().dot(half) <= 0.0 {
+            return 0.0;
+        }
+        if self.flags & crate::FLAG_HALF_SPACE != 0
+            && self.axis.dot(-to_c) + self.axis.abs().dot(half) <= 0.0
+        {
+            return 0.0;
+        }
+        let d2 = to_c.length_squared();
+        let r2 = self.radius * self.radius;
+        let d2c = d2.max(0.25 * r2).max(MIN_DIST_SQ);
+        if d2 <= r2 {
+            // x inside the bounding sphere: the cone bounds give nothing.
+            return self.power / d2c;
+        }
+        let inv_d = d2.sqrt().recip();
+        let w = to_c * inv_d; // unit, from x towards the centre
+        let sin_u = (self.radius * inv_d).min(1.0);
+        let cos_u = (1.0 - sin_u * sin_u).max(0.0).sqrt();
+
+        // Emitter: θ = angle between the axis and x − c.
+        let mut cos_t = -self.axis.dot(w);
+        if self.flags & crate::FLAG_TWO_SIDED != 0 {
+            cos_t = cos_t.abs();
+        }
+        let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+        let cos_o = self.cos_theta_o;
+        let sin_o = (1.0 - cos_o * cos_o).max(0.0).sqrt();
+        let cos_x = cos_sub_clamped(cos_t, sin_t, cos_o, sin_o);
+        let sin_x = sin_sub_clamped(cos_t, sin_t, cos_o, sin_o);
+        let cos_p = cos_sub_clamped(cos_x, sin_x, cos_u, sin_u);
+        if cos_p <= self.cos_theta_e {
+            return 0.0;
+        }
+        let emit = cos_p.max(MIN_EMIT_COS);
+
+        // Receiver: θi = angle between n and c − x; n = 0 means no receiver cosine.
+        let recv = if has_n {
+            let cos_i = n.dot(w);
+            let sin_i = (1.0 - cos_i * cos_i).max(0.0).sqrt();
+            cos_sub_clamped(cos_i, sin_i, cos_u, sin_u)
+        } else {
+            1.0
+        };
+        if recv <= 0.0 {
+            return 0.0;
+        }
+        self.power * emit * recv / d2c
+    }
+
+    /// `true` when `x` lies in the closed bounding sphere.
+    #[inline]
+    pub fn contains(&self, x: Vec3) -> bool {
+        (self.center() - x).length_squared() <= self.radius * self.radius
+    }
+}
+
+/// A cut through the tree: node ids sorted by DFS id, whose subtrees partition the lights.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Cut {
+    pub nodes: Vec<NodeId>,
+}
+
+impl Cut {
+    #[inline]
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+    /// Index into `nodes` of the cut node whose subtree holds `light` (binary search over
+    /// the DFS ids); `None` if no cut node covers it.
+    pub fn cluster_of(&self, tree: &LightTree, light: usize) -> Option<usize> {
+        let leaf = tree.leaf_of(light);
+        let i = self.nodes.partition_point(|&id| id <= leaf);
+        if i == 0 {
+            return None;
+        }
+        let c = self.nodes[i - 1];
+        (leaf <= tree.subtree_range(c).1).then_some(i - 1)
+    }
+}
+
+impl LightTree {
+    /// E&K's normalised variance measure ρ ∈ (0, 1] (eqs. 8–10 with the normalisation,
+    /// σ² multiplied by N² as in bisml and the GSoC Cycles tree): low ρ = high variance.
+    /// Leaves return 1. Distances are in scene units, so τ is scale-dependent as in E&K.
+    pub fn split_metric(&self, node: NodeId, x: Vec3) -> f32 {
+        let nd = &self.nodes[node as usize];
+        let n = nd.num_lights;
+        if n <= 1 {
+            return 1.0;
+        }
+        let nf = n as f64;
+        let d = ((nd.center() - x).length()) as f64;
+        let r = nd.radius as f64;
+        let a = (d - r).max(1e-9);
+        let b = d + r;
+        let e_g = 1.0 / (a * b);
+        // (b³ − a³)/(3(b − a)a³b³) − 1/(a²b²), with (b³ − a³)/(b − a) = a² + ab + b².
+        let ab = a * b;
+        let v_g = ((a * a + ab + b * b) / (3.0 * ab * ab * ab) - 1.0 / (ab * ab)).max(0.0);
+        let e_e = nd.power as f64 / nf;
+        let v_e = ((self.extra[node as usize].power_sq_sum as f64 - nf * e_e * e_e) / (nf - 1.0))
+            .max(0.0);
+        let s2 = (v_e * v_g + v_e * e_g * e_g + e_e * e_e * v_g) * nf * nf;
+        (1.0 / (1.0 + s2.sqrt())).powf(0.25) as f32
+    }
+
+    /// Conty Estevez & Kulla importance Φ · cos θ′ · cos θ′ᵢ / d² of node `node` for a receiver
+    /// at `x` with normal `n`:
+    /// * d = distance from `x` to the node's bounding-sphere centre, θu = half-angle the
+    ///   sphere subtends (sin θu = r/d);
+    /// * θ′ = max(θ − θo − θu, 0) with θ the angle between the cone axis and x − c (|cos θ|
+    ///   for two-sided nodes); the importance is 0 when θ′ ≥ θe;
+    /// * θ′ᵢ = max(θi − θu, 0) with θi the angle between `n` and c − x; 0 when cos θ′ᵢ ≤ 0
+    ///   (one-sided receiver: pass `n` flipped to the side of interest). `n == Vec3::ZERO`
+    ///   drops the receiver term (volumes, transmissive BSDFs).
+    /// * inside the bounding sphere (d² ≤ r²) both cosines are 1; the squared distance is
+    ///   always max(d², r²/4, 1e-12), the same clamp everywhere.
+    #[inline]
+    pub fn importance(&self, node: NodeId, x: Vec3, n: Vec3) -> f32 {
+        self.nodes[node as usize].importance(x, n)
+    }
+
+    /// Samples one light by a single descent from the root with one rescaled `u` ∈ [0, 1).
+    /// Returns `(light, pmf)`, or `None` when the descent reaches a node whose children
+    /// both have zero importance (with conservative bounds those lights cannot reach `x`).
+    #[inline]
+    pub fn sample(&self, x: Vec3, n: Vec3, u: f32) -> Option<(usize, f32)> {
+        self.sample_subtree(
+            self.root(),
+            |id| self.importance(id, x, n),
+            &mut Rescaled(u),
+        )
+    }
+
+    /// Probability that [`LightTree::sample`] returns `light`, replayed along its bit trail
+    /// with the same floating-point operations. Summed over all lights it is 1, minus the
+    /// mass of dead ends (see `sample`); 0 when every importance is 0.
+    #[inline]
+    pub fn pmf(&self, x: Vec3, n: Vec3, light: usize) -> f32 {
+        self.pmf_subtree(self.root(), |id| self.importance(id, x, n), light)
+    }
+
+    /// Generic descent from `start`: at each interior node go left with probability
+    /// I(left)/(I(left)+I(right)) (NaN/negative importances count as 0). Returns
+    /// `(light, pmf within the subtree)`, or `None` at a dead end (both children 0).
+    pub fn sample_subtree<I, R>(
+        &self,
+        start: NodeId,
+        importance: I,
+        rng: &mut R,
+    ) -> Option<(usize, f32)>
+    where
+        I: Fn(NodeId) -> f32,
+        R: DescentRandom,
+    {
+        let mut id = start;
+        let mut pmf = 1.0f32;
+        loop {
+            let node = &self.nodes[id as usize];
+            if node.is_leaf() {
+                return Some((node.child_or_light as usize, pmf));
+            }
+            let (l, r) = (id + 1, node.child_or_light);
+            let il = sanitize(importance(l));
+            let ir = sanitize(importance(r));
+            let sum = il + ir;
+            if sum == 0.0 {
+                return None;
+            }
+            let pl = il / sum;
+            let left = if ir == 0.0 {
+                true
+            } else if il == 0.0 {
+                false
+            } else {
+                rng.go_left(pl)
+            };
+            if left {
+                pmf *= pl;
+                id = l;
+            } else {
+                pmf *= ir / sum;
+                id = r;
+            }
+        }
+    }
+
+    /// Probability that [`LightTree::sample_subtree`] from `start` with the same importance
+    /// returns `light`; 0 if `light` is not under `start`.
+    pub fn pmf_subtree<I>(&self, start: NodeId, importance: I, light: usize) -> f32
+    where
+        I: Fn(NodeId) -> f32,
+    {
+        let leaf = self.leaf_of[light];
+        let (first, last) = self.subtree_range(start);
+        if leaf < first || leaf > last {
+            return 0.0;
+        }
+        let mut id = start;
+        let start_depth = self.nodes[id as usize].depth();
+        // Leaves may sit at depth 64; only interior nodes (depth < 64) shift here.
+        let mut bits = if start_depth < 64 {
+            self.trails[light] >> start_depth
+        } else {
+            0
+        };
+        let mut pmf = 1.0f32;
+        while id != leaf {
+            let node = &self.nodes[id as usize];
+            let (l, r) = (id + 1, node.child_or_light);
+            let il = sanitize(importance(l));
+            let ir = sanitize(importance(r));
+            let sum = il + ir;
+            if sum == 0.0 {
+                return 0.0;
+            }
+            if bits & 1 == 0 {
+                pmf *= il / sum;
+                id = l;
+            } else {
+                pmf *= ir / sum;
+                id = r;
+            }
+            bits >>= 1;
+        }
+        pmf
+    }
+
+    /// Generic cut: starting from `{root}`, nodes are visited breadth-first and an interior
+    /// node is replaced by its two children when `should_split(node)` holds and the cut has
+    /// fewer than `max_size` nodes. Leaves are never split. The result is sorted by DFS id
+    /// and has at most `max(max_size, 1)` nodes.
+    pub fn cut<S: FnMut(NodeId) -> bool>(&self, max_size: usize, should_split: S) -> Cut {
+        let mut out = Cut::default();
+        self.cut_into(&mut out, &mut VecDeque::new(), max_size, should_split);
+        out
+    }
+
+    /// [`LightTree::cut`] reusing the caller's buffers (`queue` is scratch).
+    pub fn cut_into<S: FnMut(NodeId) -> bool>(
+        &self,
+        out: &mut Cut,
+        queue: &mut VecDeque<NodeId>,
+        max_size: usize,
+        mut should_split: S,
+    ) {
+        out.nodes.clear();
+        queue.clear();
+        queue.push_back(self.root());
+        let mut size = 1usize;
+        while let Some(id) = queue.pop_front() {
+            let node = &self.nodes[id as usize];
+            if !node.is_leaf() && size < max_size && should_split(id) {
+                queue.push_back(id + 1);
+                queue.push_back(node.child_or_light);
+                size += 1;
+            } else {
+                out.nodes.push(id);
+            }
+        }
+        out.nodes.sort_unstable();
+    }
+
+    /// E&K adaptive cut for a receiver at (`x`, `n`): split a node when `x` lies inside its
+    /// bounding sphere or its [`LightTree::split_metric`] is below `tau` (0.85 in the authors'
+    /// code), at most `max_size` nodes. Nodes of zero importance are never split (all their
+    /// lights are provably dark at `x`).
+    pub fn adaptive_cut(&self, x: Vec3, n: Vec3, tau: f32, max_size: usize) -> Cut {
+        self.cut(max_size, |id| {
+            let node = &self.nodes[id as usize];
+            (node.contains(x) || self.split_metric(id, x) < tau) && node.importance(x, n) > 0.0
+        })
+    }
+}
