@@ -10,20 +10,30 @@ pub mod convergence;
 pub mod light_strategy;
 pub mod mis;
 pub mod selection;
+pub mod tree_selection;
 
 use light_strategy::{BsdfStrategy, LightStrategy};
 use render_core::estimator::DirectLighting;
 use render_core::scene::Scene;
 use selection::{PowerSelection, UniformSelection};
 use serde::{Deserialize, Serialize};
+use tree_selection::{TreeMode, TreeSelection};
 
 /// Knobs of the strategies, each with its default; strategies ignore the ones they do not use.
 #[derive(Clone, Debug, Serialize, Deserialize)]
-pub struct StrategyOptions {}
+pub struct StrategyOptions {
+    /// Splitting threshold τ of adaptive tree splitting (Conty Estevez & Kulla; the authors' code uses 0.85).
+    pub tau: f32,
+    /// Most clusters in an adaptive cut.
+    pub max_cut: usize,
+}
 
 impl Default for StrategyOptions {
     fn default() -> Self {
-        StrategyOptions {}
+        StrategyOptions {
+            tau: 0.85,
+            max_cut: 64,
+        }
     }
 }
 
@@ -33,6 +43,8 @@ pub enum StrategyError {
     Unknown { name: String, known: String },
     #[error("strategy `{0}` is not implemented yet")]
     NotImplemented(String),
+    #[error("bad strategy option: {0}")]
+    BadOption(String),
 }
 
 /// A strategy's name and what it does.
@@ -68,18 +80,18 @@ pub fn strategies() -> Vec<StrategyInfo> {
         s(
             "tree",
             "light tree, single descent (Conty Estevez & Kulla 2018)",
-            false,
+            true,
         ),
-        s("tree-split", "light tree with adaptive splitting", false),
+        s("tree-split", "light tree with adaptive splitting", true),
         s(
             "tree+bsdf",
             "light tree single descent + BSDF sampling, MIS",
-            false,
+            true,
         ),
         s(
             "tree-split+bsdf",
             "adaptive tree splitting + BSDF sampling, MIS (the paper's E&K baseline)",
-            false,
+            true,
         ),
         s(
             "brdf-oriented",
@@ -103,9 +115,39 @@ pub fn strategies() -> Vec<StrategyInfo> {
 pub fn create(
     name: &str,
     scene: &Scene,
-    _opts: &StrategyOptions,
+    opts: &StrategyOptions,
 ) -> Result<Box<dyn DirectLighting>, StrategyError> {
+    if opts.max_cut == 0 || !(opts.tau >= 0.0 && opts.tau <= 1.0) {
+        return Err(StrategyError::BadOption(format!(
+            "need max_cut ≥ 1 and τ in [0, 1], got max_cut = {}, τ = {}",
+            opts.max_cut, opts.tau
+        )));
+    }
+    let tree =
+        |mode: TreeMode, with_bsdf: bool| -> Result<Box<dyn DirectLighting>, StrategyError> {
+            let parameters = match mode {
+                TreeMode::Single => serde_json::Value::Null,
+                TreeMode::Split { tau, max_cut } => {
+                    serde_json::json!({ "tau": tau, "max_cut": max_cut })
+                }
+            };
+            let selection = TreeSelection::new(scene, mode).map_err(StrategyError::BadOption)?;
+            Ok(Box::new(LightStrategy {
+                name: name.into(),
+                selection,
+                with_bsdf,
+                parameters,
+            }))
+        };
+    let split = TreeMode::Split {
+        tau: opts.tau,
+        max_cut: opts.max_cut,
+    };
     Ok(match name {
+        "tree" => tree(TreeMode::Single, false)?,
+        "tree+bsdf" => tree(TreeMode::Single, true)?,
+        "tree-split" => tree(split, false)?,
+        "tree-split+bsdf" => tree(split, true)?,
         "uniform" => Box::new(LightStrategy {
             name: name.into(),
             selection: UniformSelection::new(scene),

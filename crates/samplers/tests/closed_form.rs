@@ -6,7 +6,7 @@ use render_core::scene::SceneBuilder;
 use samplers::{StrategyOptions, create};
 use std::f64::consts::PI;
 
-const STRATEGIES: [&str; 4] = ["uniform", "power", "bsdf", "power+bsdf"];
+const STRATEGIES: [&str; 8] = ["uniform", "power", "bsdf", "power+bsdf", "tree", "tree+bsdf", "tree-split", "tree-split+bsdf"];
 
 #[test]
 fn sphere_light_over_lambertian_plane() {
@@ -77,7 +77,7 @@ fn point_light_is_exact_for_light_sampling() {
     let x = Vec3::new(1e-3, 2e-3, 0.0);
     let d = p - x;
     let expected = 10.0 * (d.z / d.length()) as f64 / (d.length_squared() as f64) / PI;
-    for name in ["uniform", "power", "power+bsdf"] {
+    for name in ["uniform", "power", "power+bsdf", "tree", "tree-split+bsdf"] {
         let st = create(name, &scene, &StrategyOptions::default()).unwrap();
         let (mean, _) = estimate_at_origin(&scene, st.as_ref(), 100, 3);
         assert!(
