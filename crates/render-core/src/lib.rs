@@ -7,11 +7,13 @@
 
 pub mod accel;
 pub mod bsdf;
+pub mod builtin;
 pub mod camera;
 pub mod chi2;
 pub mod error;
 pub mod estimator;
 pub mod frame;
+pub mod gltf_loader;
 pub mod light;
 pub mod material;
 pub mod microfacet;
@@ -25,3 +27,14 @@ pub mod texture;
 
 pub use error::SceneError;
 pub use glam::{Vec2, Vec3};
+
+/// Loads a scene named on the command line: `builtin:NAME?key=value&…` or a glTF path.
+pub fn load_scene(spec: &str, camera: Option<&str>) -> Result<scene::Scene, SceneError> {
+    if spec.starts_with("builtin:") {
+        let mut scene = builtin::load_builtin(spec)?;
+        gltf_loader::select_camera(&mut scene, camera)?;
+        Ok(scene)
+    } else {
+        gltf_loader::load_gltf(std::path::Path::new(spec), camera)
+    }
+}

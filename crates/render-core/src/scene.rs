@@ -28,6 +28,8 @@ pub struct Triangle {
 pub struct SceneStats {
     pub triangles: usize,
     pub degenerate_triangles_skipped: usize,
+    /// Input primitives that are not triangles (points, lines), not loaded.
+    pub non_triangle_primitives_skipped: usize,
     pub triangle_lights: usize,
     pub sphere_lights: usize,
     pub point_lights: usize,
@@ -405,6 +407,11 @@ impl SceneBuilder {
         });
         self.stats.distant_lights += 1;
         Ok(())
+    }
+
+    /// Counts input primitives that were not loaded (points, lines).
+    pub fn count_skipped_primitives(&mut self, n: usize) {
+        self.stats.non_triangle_primitives_skipped += n;
     }
 
     pub fn add_camera(&mut self, camera: Camera) {

@@ -1,0 +1,314 @@
+//! Built-in procedural scenes, addressed as `builtin:NAME?key=value&…`.
+//!
+//! Every scene is deterministic for its parameters: the random layout comes from a
+//! `rand_pcg::Pcg32` seeded with `seed`. Each has a camera and a default image size chosen so
+//! that a 16-spp render is a meaningful test image. Light emission is scaled so the total
+//! emitted power (and so the exposure) does not depend on the light count or radius.
+//!
+//! `roughness` is glTF's perceptual roughness: the GGX α is roughness² (roughness 0.1 → α 0.01).
+mod diffuse_quads;
+mod glossy_spheres;
+pub mod mesh;
+
+use crate::error::SceneError;
+use crate::material::Material;
+use crate::scene::{Scene, SceneBuilder};
+use glam::Vec3;
+use rand::{RngExt, SeedableRng};
+use rand_pcg::Pcg32;
+use std::f32::consts::PI;
+
+/// What `manylights scenes` prints about one built-in scene.
+#[derive(Clone, Debug)]
+pub struct BuiltinInfo {
+    pub name: &'static str,
+    pub description: &'static str,
+    /// (key, default value, help) of every parameter.
+    pub keys: Vec<(&'static str, &'static str, &'static str)>,
+}
+
+/// One parameter of a built-in scene.
+struct Key {
+    name: &'static str,
+    default: &'static str,
+    help: &'static str,
+}
+
+const fn key(name: &'static str, default: &'static str, help: &'static str) -> Key {
+    Key {
+        name,
+        default,
+        help,
+    }
+}
+
+const SEED_HELP: &str = "seed of the random layout (integer)";
+const ROUGHNESS_HELP: &str =
+    "glTF roughness of the glossy surfaces, in [0, 1]; GGX alpha = roughness^2";
+
+struct Def {
+    name: &'static str,
+    description: &'static str,
+    keys: &'static [Key],
+    build: fn(&Params) -> Result<SceneBuilder, SceneError>,
+}
+
+const SCENES: &[Def] = &[
+    Def {
+        name: "glossy-spheres",
+        description: "N small sphere lights spread wide above a glossy ground with glossy and diffuse spheres and boxes",
+        keys: &[
+            key("lights", "4096", "number of sphere lights"),
+            key("radius", "0.01", "radius of each sphere light"),
+            key("roughness", "0.1", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: glossy_spheres::build,
+    },
+    Def {
+        name: "diffuse-quads",
+        description: "many small one-sided emissive quads facing down over purely diffuse geometry",
+        keys: &[
+            key(
+                "lights",
+                "1024",
+                "number of emissive quads (2 triangle lights each)",
+            ),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: diffuse_quads::build,
+    },
+];
+
+/// The most lights any built-in accepts.
+pub const MAX_LIGHTS: usize = 1_000_000;
+
+/// Every built-in scene with its keys and defaults.
+pub fn list_builtins() -> Vec<BuiltinInfo> {
+    SCENES
+        .iter()
+        .map(|d| BuiltinInfo {
+            name: d.name,
+            description: d.description,
+            keys: d.keys.iter().map(|k| (k.name, k.default, k.help)).collect(),
+        })
+        .collect()
+}
+
+/// Builds the scene named by `builtin:NAME?key=value&…` (the `builtin:` prefix is optional).
+/// The scene's name is the canonical spec with every key spelled out.
+pub fn load_builtin(spec: &str) -> Result<Scene, SceneError> {
+    let params = Params::parse(spec)?;
+    let def = params.def;
+    (def.build)(&params)?.build()
+}
+
+/// Parsed parameters of one built-in scene: every key of the scene with its value text.
+pub struct Params {
+    def: &'static Def,
+    values: Vec<(&'static str, String)>,
+}
+
+impl Params {
+    fn parse(spec: &str) -> Result<Params, SceneError> {
+        let rest = spec.strip_prefix("builtin:").unwrap_or(spec);
+        let (name, query) = rest.split_once('?').unwrap_or((rest, ""));
+        let known = || SCENES.iter().map(|d| d.name).collect::<Vec<_>>().join(", ");
+        let def =
+            SCENES
+                .iter()
+                .find(|d| d.name == name)
+                .ok_or_else(|| SceneError::UnknownBuiltin {
+                    name: name.into(),
+                    known: known(),
+                })?;
+        let mut values: Vec<(&'static str, String)> = def
+            .keys
+            .iter()
+            .map(|k| (k.name, k.default.to_string()))
+            .collect();
+        let mut seen: Vec<&str> = Vec::new();
+        for part in query.split('&').filter(|p| !p.is_empty()) {
+            let bad = |key: &str, message: String| SceneError::BadBuiltinParam {
+                scene: def.name.into(),
+                key: key.into(),
+                message,
+            };
+            let (k, v) = part
+                .split_once('=')
+                .ok_or_else(|| bad(part, "expected key=value".into()))?;
+            let valid = || {
+                def.keys
+                    .iter()
+                    .map(|k| k.name)
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
+            let slot = values
+                .iter_mut()
+                .find(|(name, _)| *name == k)
+                .ok_or_else(|| bad(k, format!("unknown key (valid keys: {})", valid())))?;
+            if seen.contains(&k) {
+                return Err(bad(k, "given twice".into()));
+            }
+            seen.push(k);
+            slot.1 = v.to_string();
+        }
+        let params = Params { def, values };
+        // Check every value now, so a bad one is reported before any work.
+        for k in def.keys {
+            match k.name {
+                "seed" => {
+                    params.seed()?;
+                }
+                "lights" => {
+                    params.count("lights", 1, MAX_LIGHTS)?;
+                }
+                "radius" => {
+                    params.number("radius", 1e-6, 1.0)?;
+                }
+                "roughness" => {
+                    params.number("roughness", 0.0, 1.0)?;
+                }
+                _ => {}
+            }
+        }
+        Ok(params)
+    }
+
+    fn text(&self, key: &str) -> &str {
+        &self
+            .values
+            .iter()
+            .find(|(k, _)| *k == key)
+            .unwrap_or_else(|| panic!("built-in `{}` reads undeclared key `{key}`", self.def.name))
+            .1
+    }
+
+    fn bad(&self, key: &str, message: String) -> SceneError {
+        SceneError::BadBuiltinParam {
+            scene: self.def.name.into(),
+            key: key.into(),
+            message,
+        }
+    }
+
+    /// The canonical spec: `builtin:NAME?k=v&…` with every key in declaration order.
+    pub fn canonical(&self) -> String {
+        let q: Vec<String> = self
+            .values
+            .iter()
+            .map(|(k, v)| format!("{k}={v}"))
+            .collect();
+        format!("builtin:{}?{}", self.def.name, q.join("&"))
+    }
+
+    /// An integer in [min, max]; scientific notation (`1e6`) is accepted when integral.
+    pub fn count(&self, key: &str, min: usize, max: usize) -> Result<usize, SceneError> {
+        let t = self.text(key);
+        let n = match t.parse::<usize>() {
+            Ok(n) => n,
+            Err(_) => match t.parse::<f64>() {
+                Ok(f)
+                    if f.is_finite() && f >= 0.0 && f.fract() == 0.0 && f <= usize::MAX as f64 =>
+                {
+                    f as usize
+                }
+                _ => return Err(self.bad(key, format!("`{t}` is not a whole number"))),
+            },
+        };
+        if n < min || n > max {
+            return Err(self.bad(key, format!("{n} is outside [{min}, {max}]")));
+        }
+        Ok(n)
+    }
+
+    /// A finite number in [min, max].
+    pub fn number(&self, key: &str, min: f32, max: f32) -> Result<f32, SceneError> {
+        let t = self.text(key);
+        let x: f32 = t
+            .parse()
+            .map_err(|_| self.bad(key, format!("`{t}` is not a number")))?;
+        if !x.is_finite() || x < min || x > max {
+            return Err(self.bad(key, format!("{t} is outside [{min}, {max}]")));
+        }
+        Ok(x)
+    }
+
+    pub fn seed(&self) -> Result<u64, SceneError> {
+        let t = self.text("seed");
+        t.parse()
+            .map_err(|_| self.bad("seed", format!("`{t}` is not a non-negative integer")))
+    }
+
+    /// The layout's random number generator.
+    pub fn rng(&self) -> Result<Pcg32, SceneError> {
+        Ok(Pcg32::seed_from_u64(self.seed()?))
+    }
+
+    pub fn lights(&self) -> Result<usize, SceneError> {
+        self.count("lights", 1, MAX_LIGHTS)
+    }
+
+    pub fn radius(&self) -> Result<f32, SceneError> {
+        self.number("radius", 1e-6, 1.0)
+    }
+
+    pub fn roughness(&self) -> Result<f32, SceneError> {
+        self.number("roughness", 0.0, 1.0)
+    }
+
+    pub fn builder(&self) -> SceneBuilder {
+        SceneBuilder::new(&self.canonical())
+    }
+}
+
+/// Light colours of luminance 1: warm and cool whites and a few tints.
+pub fn light_color(rng: &mut Pcg32) -> Vec3 {
+    const PALETTE: [[f32; 3]; 8] = [
+        [1.0, 0.85, 0.65],
+        [1.0, 0.95, 0.9],
+        [0.8, 0.9, 1.0],
+        [1.0, 0.6, 0.35],
+        [0.55, 0.75, 1.0],
+        [1.0, 0.5, 0.6],
+        [0.6, 1.0, 0.6],
+        [1.0, 1.0, 1.0],
+    ];
+    let c = Vec3::from(PALETTE[(rng.random::<u32>() % PALETTE.len() as u32) as usize]);
+    c / crate::light::luminance(c)
+}
+
+/// Radiance (luminance) of each of `n` sphere lights of radius `r` so that together they emit
+/// `total_power` (the unit of `Light::power`: π·L·4πr² per sphere).
+pub fn sphere_radiance(total_power: f32, n: usize, r: f32) -> f32 {
+    total_power / (n as f32 * 4.0 * PI * PI * r * r)
+}
+
+/// Radiance (luminance) of each of `n` one-sided emitters of area `area` emitting
+/// `total_power` together (π·L·A each).
+pub fn area_radiance(total_power: f32, n: usize, area: f32) -> f32 {
+    total_power / (n as f32 * PI * area)
+}
+
+/// A black, one-sided (unless `double_sided`) emitter material.
+pub fn emitter(name: &str, radiance: Vec3, double_sided: bool) -> Material {
+    Material {
+        emission: radiance,
+        double_sided,
+        ..Material::diffuse(name, Vec3::splat(0.02))
+    }
+}
+
+/// A uniform number in [a, b).
+pub fn uniform(rng: &mut Pcg32, a: f32, b: f32) -> f32 {
+    a + (b - a) * rng.random::<f32>()
+}
+
+/// A uniform index in [0, n).
+pub fn pick(rng: &mut Pcg32, n: usize) -> usize {
+    rng.random_range(0..n as u32) as usize
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,228 @@
+use super::*;
+use crate::light::LightShape;
+
+fn err(r: Result<Scene, SceneError>) -> SceneError {
+    match r {
+        Ok(_) => panic!("expected an error"),
+        Err(e) => e,
+    }
+}
+
+/// A point of every light, in order.
+fn light_points(s: &Scene) -> Vec<Vec3> {
+    s.lights
+        .iter()
+        .map(|l| match l.shape {
+            LightShape::Sphere { center, .. } => center,
+            LightShape::Triangle { p, .. } => p[0],
+            LightShape::Point { position } => position,
+        })
+        .collect()
+}
+
+fn lights_of(s: &Scene) -> usize {
+    s.stats.sphere_lights + s.stats.triangle_lights + s.stats.point_lights + s.stats.spot_lights
+}
+
+/// Light count a scene has for `lights=n` (quads are 2 triangles, car adds 3 panels).
+fn expected_lights(name: &str, n: usize) -> usize {
+    match name {
+        "diffuse-quads" => 2 * n,
+        "car" => n + 6,
+        _ => n,
+    }
+}
+
+#[test]
+fn every_builtin_builds_is_deterministic_and_follows_its_keys() {
+    for info in list_builtins() {
+        let name = info.name;
+        let has = |k: &str| info.keys.iter().any(|(key, _, _)| *key == k);
+        assert!(has("lights") && has("seed"), "{name}");
+        let a = load_builtin(&format!("builtin:{name}?lights=300&seed=7")).unwrap();
+        let b = load_builtin(&format!("builtin:{name}?seed=7&lights=300")).unwrap();
+        let c = load_builtin(&format!("builtin:{name}?lights=300&seed=8")).unwrap();
+        assert_eq!(lights_of(&a), expected_lights(name, 300), "{name}");
+        assert!(a.triangles.len() > 10, "{name}");
+        assert_eq!(a.stats.degenerate_triangles_skipped, 0, "{name}");
+        assert_eq!(
+            light_points(&a),
+            light_points(&b),
+            "{name}: same seed, same layout"
+        );
+        assert_ne!(
+            light_points(&a),
+            light_points(&c),
+            "{name}: another seed, another layout"
+        );
+        assert_eq!(a.name, b.name);
+        assert!(
+            a.name.starts_with(&format!("builtin:{name}?")) && a.name.contains("lights=300"),
+            "{}",
+            a.name
+        );
+        assert!(a.stats.total_power_w > 0.0 && a.stats.total_power_w.is_finite());
+        let cam = a.camera(None).unwrap();
+        assert!(
+            cam.width >= 200 && cam.height >= 200 && cam.name != "default",
+            "{name}"
+        );
+        // The camera sees the scene: its view direction points into the bounds' general direction.
+        let centre = 0.5 * (a.bounds.0 + a.bounds.1);
+        assert!(cam.forward.dot(centre - cam.position) > 0.0, "{name}");
+
+        if has("radius") {
+            let r = load_builtin(&format!("builtin:{name}?lights=50&radius=0.0123")).unwrap();
+            let radii: Vec<f32> = r
+                .lights
+                .iter()
+                .filter_map(|l| {
+                    if let LightShape::Sphere { radius, .. } = l.shape {
+                        Some(radius)
+                    } else {
+                        None
+                    }
+                })
+                .collect();
+            assert_eq!(radii.len(), 50, "{name}");
+            assert!(radii.iter().all(|&x| x == 0.0123), "{name}");
+        }
+        if has("roughness") {
+            let r = load_builtin(&format!("builtin:{name}?lights=10&roughness=0.37")).unwrap();
+            assert!(r.materials.iter().any(|m| m.roughness == 0.37), "{name}");
+        }
+        // Emission is normalised: total power does not depend on the light count.
+        let few = load_builtin(&format!("builtin:{name}?lights=100")).unwrap();
+        let many = load_builtin(&format!("builtin:{name}?lights=400")).unwrap();
+        let ratio = few.stats.total_power_w / many.stats.total_power_w;
+        assert!((ratio - 1.0).abs() < 0.05, "{name}: power ratio {ratio}");
+
+        let e = err(load_builtin(&format!("builtin:{name}?bogus=1")));
+        assert!(
+            matches!(e, SceneError::BadBuiltinParam { .. }) && e.to_string().contains("lights"),
+            "{e}"
+        );
+        for bad in [
+            "lights=0",
+            "lights=abc",
+            "lights=2e6",
+            "seed=-1",
+            "lights=5&lights=6",
+            "lights",
+        ] {
+            let e = err(load_builtin(&format!("builtin:{name}?{bad}")));
+            assert!(
+                matches!(e, SceneError::BadBuiltinParam { .. }),
+                "{name}?{bad}: {e}"
+            );
+        }
+        if has("radius") {
+            for bad in ["radius=0", "radius=-1", "radius=nan", "radius=inf"] {
+                assert!(
+                    matches!(
+                        err(load_builtin(&format!("builtin:{name}?{bad}"))),
+                        SceneError::BadBuiltinParam { .. }
+                    ),
+                    "{bad}"
+                );
+            }
+        }
+        if has("roughness") {
+            assert!(matches!(
+                err(load_builtin(&format!("builtin:{name}?roughness=1.5"))),
+                SceneError::BadBuiltinParam { .. }
+            ));
+        }
+    }
+}
+
+#[test]
+fn unknown_scenes_are_rejected_with_the_known_names() {
+    let e = err(load_builtin("builtin:nope"));
+    assert!(matches!(e, SceneError::UnknownBuiltin { .. }));
+    for info in list_builtins() {
+        assert!(e.to_string().contains(info.name), "{e}");
+    }
+    assert!(matches!(
+        load_builtin("builtin:"),
+        Err(SceneError::UnknownBuiltin { .. })
+    ));
+}
+
+#[test]
+fn specs_parse_with_and_without_prefix_and_scientific_counts() {
+    let p = Params::parse("builtin:glossy-spheres?lights=1e3&seed=3").unwrap();
+    assert_eq!(p.lights().unwrap(), 1000);
+    assert_eq!(
+        p.canonical(),
+        "builtin:glossy-spheres?lights=1e3&radius=0.01&roughness=0.1&seed=3"
+    );
+    assert!(Params::parse("glossy-spheres").is_ok());
+    assert!(Params::parse("builtin:glossy-spheres?").is_ok());
+    assert_eq!(
+        Params::parse("builtin:glossy-spheres?lights=1.5e3")
+            .unwrap()
+            .lights()
+            .unwrap(),
+        1500
+    );
+    assert!(Params::parse("builtin:glossy-spheres?lights=1.25").is_err());
+}
+
+#[test]
+fn names_are_unique_and_documented() {
+    let infos = list_builtins();
+    for (i, a) in infos.iter().enumerate() {
+        assert!(!a.description.is_empty());
+        assert!(infos[i + 1..].iter().all(|b| b.name != a.name));
+        for (k, default, help) in &a.keys {
+            assert!(!k.is_empty() && !default.is_empty() && !help.is_empty());
+        }
+    }
+    for required in ["glossy-spheres", "diffuse-quads"] {
+        assert!(infos.iter().any(|i| i.name == required), "{required}");
+    }
+}
+
+#[test]
+fn glossy_spheres_defaults() {
+    let s = load_builtin("builtin:glossy-spheres").unwrap();
+    assert_eq!(s.stats.sphere_lights, 4096);
+    let lo = s
+        .lights
+        .iter()
+        .map(|l| l.bounds().0)
+        .fold(Vec3::INFINITY, Vec3::min);
+    let hi = s
+        .lights
+        .iter()
+        .map(|l| l.bounds().1)
+        .fold(Vec3::NEG_INFINITY, Vec3::max);
+    // Spread wide: far more than the objects' extent.
+    assert!(hi.x - lo.x > 25.0 && hi.z - lo.z > 25.0);
+    assert!(
+        s.materials
+            .iter()
+            .any(|m| m.roughness == 0.1 && m.specular > 0.0)
+    );
+    assert!(s.materials.iter().any(|m| m.specular == 0.0));
+}
+
+#[test]
+fn diffuse_quads_are_one_sided_and_face_down_over_diffuse_geometry() {
+    let s = load_builtin("builtin:diffuse-quads?lights=64").unwrap();
+    assert_eq!(s.stats.triangle_lights, 128);
+    for l in &s.lights {
+        let LightShape::Triangle { normal, .. } = l.shape else {
+            panic!()
+        };
+        assert!((normal - Vec3::NEG_Y).length() < 1e-5);
+        assert!(!l.two_sided);
+    }
+    assert!(
+        s.materials
+            .iter()
+            .filter(|m| !m.is_emissive())
+            .all(|m| m.specular == 0.0)
+    );
+}

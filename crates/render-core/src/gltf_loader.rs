@@ -1,0 +1,1176 @@
+//! glTF 2.0 scenes (`.gltf` / `.glb`) through the `gltf` crate.
+//!
+//! What is read:
+//! - every triangle primitive (`TRIANGLES`, `TRIANGLE_STRIP`, `TRIANGLE_FAN`; indexed or not) of
+//!   every node of the default scene (else the first scene, else every root node), under the
+//!   node's full world transform; `POSITION`, `NORMAL` and one `TEXCOORD_n` set;
+//!   points and lines are skipped and counted in [`SceneStats`](crate::scene::SceneStats);
+//! - metallic-roughness materials: baseColor factor × texture (sRGB decoded), metallic and
+//!   roughness factors × texture (linear, G = roughness, B = metallic), `KHR_materials_specular`
+//!   specularFactor (1 when absent), doubleSided, and emission = emissiveFactor ×
+//!   `KHR_materials_emissive_strength` × emissiveTexture (sRGB decoded). The [`SceneBuilder`]
+//!   turns emissive triangles into area lights (zero-average ones are not lights);
+//! - `KHR_lights_punctual`: see [`PunctualUnits`] below for the unit convention;
+//! - perspective cameras (`yfov`, `aspectRatio`), looking down the node's −Z with +Y up.
+//!
+//! Not modelled (read as an opaque metallic-roughness surface, reported in
+//! [`GltfReport::warnings`]): transmission, clearcoat, sheen, volume, alpha blending/masking,
+//! normal and occlusion maps, the specular texture and colour, texture sampler wrap modes
+//! (always repeat), orthographic cameras, punctual light `range`.
+//!
+//! # Punctual light units
+//! glTF gives point and spot intensities in candela and directional ones in lux. The renderer
+//! works in plain radiometric units, and the converted scenes of `../shared/scenes`
+//! (bisml_cornell) store `color × intensity` = radiant intensity I directly. So:
+//! - point / spot: I = `color × intensity` (W/sr); with a node `extras.radius` r > 0 (or the
+//!   light's own `extras.radius`), a sphere light of radiance L = I / (π r²), which has the
+//!   same intensity when seen from outside; the radius is not scaled by the node transform;
+//! - spot: emission axis = node −Z, cone from `innerConeAngle` / `outerConeAngle`;
+//! - directional: irradiance E = `color × intensity`, direction to the light = node +Z.
+//!
+//! No photometric (lumen → watt) conversion is applied.
+use crate::camera::Camera;
+use crate::error::SceneError;
+use crate::light::SpotCone;
+use crate::material::Material;
+use crate::scene::{Scene, SceneBuilder};
+use crate::texture::{Texture, srgb_to_linear};
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use std::collections::HashMap;
+use std::f32::consts::PI;
+use std::path::Path;
+use std::sync::Arc;
+
+/// The extensions a file may list in `extensionsRequired`.
+pub const SUPPORTED_REQUIRED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_transmission",
+    "KHR_materials_specular",
+    "KHR_texture_transform",
+];
+
+/// Marker type documenting the light-unit convention (see the module documentation).
+pub enum PunctualUnits {}
+
+/// Default image height of a glTF camera; the width follows its aspect ratio.
+pub const DEFAULT_CAMERA_HEIGHT: u32 = 512;
+
+/// What one glTF file contributed to a [`SceneBuilder`].
+#[derive(Clone, Debug, Default)]
+pub struct GltfReport {
+    /// Triangle primitives read.
+    pub primitives: usize,
+    /// Triangles handed to the builder (degenerate ones are then skipped by the builder).
+    pub triangles: usize,
+    /// Point and line primitives, and primitives without positions: not loaded.
+    pub skipped_primitives: usize,
+    pub sphere_lights: usize,
+    pub point_lights: usize,
+    pub spot_lights: usize,
+    pub distant_lights: usize,
+    pub cameras: usize,
+    /// Features of the file that were ignored, each once.
+    pub warnings: Vec<String>,
+}
+
+impl GltfReport {
+    fn warn(&mut self, w: String) {
+        if !self.warnings.contains(&w) {
+            self.warnings.push(w);
+        }
+    }
+
+    fn punctual_lights(&self) -> usize {
+        self.sphere_lights + self.point_lights + self.spot_lights + self.distant_lights
+    }
+}
+
+/// Loads a glTF file as a scene. With `camera = Some(name)`, the camera of that name (glTF
+/// camera name, else its node's name) becomes the scene's first camera, so
+/// `Scene::camera(None)` returns it; an unknown name is an error. A file without cameras gets
+/// `Camera::framing` of its bounds from `Scene::camera(None)`.
+pub fn load_gltf(path: &Path, camera: Option<&str>) -> Result<Scene, SceneError> {
+    load_gltf_with_report(path, camera).map(|(scene, _)| scene)
+}
+
+/// [`load_gltf`], also returning what was read and what was ignored.
+pub fn load_gltf_with_report(
+    path: &Path,
+    camera: Option<&str>,
+) -> Result<(Scene, GltfReport), SceneError> {
+    let mut builder = SceneBuilder::new(&path.display().to_string());
+    let report = add_gltf(&mut builder, path, Mat4::IDENTITY)?;
+    if report.triangles == 0 {
+        if report.punctual_lights() == 0 {
+            return Err(SceneError::Empty);
+        }
+        return Err(gltf_err(
+            path,
+            format!(
+                "no triangles (only {} punctual lights): nothing to shade",
+                report.punctual_lights()
+            ),
+        ));
+    }
+    let mut scene = builder.build()?;
+    if scene.triangles.is_empty() {
+        return Err(gltf_err(
+            path,
+            format!("no triangles: all {} are degenerate", report.triangles),
+        ));
+    }
+    select_camera(&mut scene, camera)?;
+    Ok((scene, report))
+}
+
+/// Makes the camera called `name` the scene's first one (the one `Scene::camera(None)`
+/// returns); `None` changes nothing, an unknown name is an error.
+pub fn select_camera(scene: &mut Scene, name: Option<&str>) -> Result<(), SceneError> {
+    if let Some(name) = name {
+        let i = scene
+            .cameras
+            .iter()
+            .position(|c| c.name == name)
+            .ok_or_else(|| SceneError::CameraNotFound(name.into()))?;
+        let c = scene.cameras.remove(i);
+        scene.cameras.insert(0, c);
+    }
+    Ok(())
+}
+
+fn gltf_err(path: &Path, message: impl Into<String>) -> SceneError {
+    SceneError::Gltf {
+        path: path.display().to_string(),
+        message: message.into(),
+    }
+}
+
+/// Adds everything of a glTF file to `builder`, with `transform` applied on top of the file's
+/// own node transforms (for scene composition). Cameras are added too.
+pub fn add_gltf(
+    builder: &mut SceneBuilder,
+    path: &Path,
+    transform: Mat4,
+) -> Result<GltfReport, SceneError> {
+    let bytes = std::fs::read(path).map_err(|e| SceneError::Io {
+        path: path.display().to_string(),
+        message: e.to_string(),
+    })?;
+    // Check the required extensions first, so an unsupported one gets its own message
+    // instead of a validation report.
+    let raw = gltf::Gltf::from_slice_without_validation(&bytes)
+        .map_err(|e| gltf_err(path, e.to_string()))?;
+    for ext in raw.extensions_required() {
+        if !SUPPORTED_REQUIRED_EXTENSIONS.contains(&ext) {
+            return Err(gltf_err(
+                path,
+                format!("requires extension `{ext}`, which is not supported"),
+            ));
+        }
+    }
+    drop(raw);
+    let gltf::Gltf { document, blob } =
+        gltf::Gltf::from_slice(&bytes).map_err(|e| gltf_err(path, e.to_string()))?;
+    drop(bytes);
+    let base = path.parent().unwrap_or_else(|| Path::new("."));
+    let buffers = gltf::import_buffers(&document, Some(base), blob)
+        .map_err(|e| gltf_err(path, format!("buffers: {e}")))?;
+    let mut loader = Loader {
+        path,
+        doc: &document,
+        base,
+        buffers: &buffers,
+        builder,
+        textures: HashMap::new(),
+        materials: HashMap::new(),
+        report: GltfReport::default(),
+    };
+    // Reading accessors through the gltf crate is bounds-checked; a panic would still be a
+    // bug in a dependency on a hostile file, so it becomes an error instead of a crash.
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| loader.load(transform)));
+    let report = std::mem::take(&mut loader.report);
+    match result {
+        Ok(Ok(())) => Ok(report),
+        Ok(Err(e)) => Err(e),
+        Err(_) => Err(gltf_err(
+            path,
+            "the file could not be read (malformed data)",
+        )),
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct UvSpec {
+    set: u32,
+    /// KHR_texture_transform: uv' = offset + R(rotation)·(scale ⊙ uv).
+    transform: Option<([f32; 2], f32, [f32; 2])>,
+}
+
+struct Loader<'a> {
+    path: &'a Path,
+    doc: &'a gltf::Document,
+    base: &'a Path,
+    buffers: &'a [gltf::buffer::Data],
+    builder: &'a mut SceneBuilder,
+    /// (image index, sRGB) → decoded linear texture.
+    textures: HashMap<(usize, bool), Arc<Texture>>,
+    /// glTF material index (None = default material) → builder material and its uv set.
+    materials: HashMap<Option<usize>, (u32, UvSpec)>,
+    report: GltfReport,
+}
+
+/// Reads a number from a node's or light's `extras` JSON object.
+fn extras_number(extras: &gltf::json::Extras, key: &str) -> Option<Result<f32, String>> {
+    let raw = extras.as_ref()?;
+    let v: serde_json::Value = match serde_json::from_str(raw.get()) {
+        Ok(v) => v,
+        Err(e) => return Some(Err(format!("unreadable extras: {e}"))),
+    };
+    let x = v.get(key)?;
+    Some(
+        x.as_f64()
+            .map(|f| f as f32)
+            .ok_or_else(|| format!("extras.{key} is not a number: {x}")),
+    )
+}
+
+impl Loader<'_> {
+    fn err(&self, message: impl Into<String>) -> SceneError {
+        gltf_err(self.path, message)
+    }
+
+    fn load(&mut self, root: Mat4) -> Result<(), SceneError> {
+        let doc = self.doc;
+        let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
+            Some(scene) => scene.nodes().collect(),
+            None => {
+                // No scene at all: every node that is nobody's child.
+                let mut is_child = vec![false; doc.nodes().len()];
+                for n in doc.nodes() {
+                    for c in n.children() {
+                        is_child[c.index()] = true;
+                    }
+                }
+                doc.nodes().filter(|n| !is_child[n.index()]).collect()
+            }
+        };
+        let max_depth = doc.nodes().len();
+        let mut stack: Vec<(gltf::Node, Mat4, usize)> =
+            roots.into_iter().rev().map(|n| (n, root, 0)).collect();
+        while let Some((node, parent, depth)) = stack.pop() {
+            if depth > max_depth {
+                return Err(self.err("the node hierarchy has a cycle"));
+            }
+            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            let world = parent * local;
+            if let Some(mesh) = node.mesh() {
+                self.add_mesh(&node, &mesh, world)?;
+            }
+            if let Some(light) = node.light() {
+                self.add_light(&node, &light, world)?;
+            }
+            if let Some(camera) = node.camera() {
+                self.add_camera(&node, &camera, world)?;
+            }
+            if node.skin().is_some() {
+                self.report
+                    .warn("skins are ignored (meshes are read in their bind pose)".into());
+            }
+            let children: Vec<gltf::Node> = node.children().collect();
+            for c in children.into_iter().rev() {
+                stack.push((c, world, depth + 1));
+            }
+        }
+        Ok(())
+    }
+
+    fn add_mesh(
+        &mut self,
+        node: &gltf::Node,
+        mesh: &gltf::Mesh,
+        world: Mat4,
+    ) -> Result<(), SceneError> {
+        let mesh_name = mesh
+            .name()
+            .or(node.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+        for prim in mesh.primitives() {
+            use gltf::mesh::Mode;
+            let mode = prim.mode();
+            if !matches!(
+                mode,
+                Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
+            ) {
+                self.report.skipped_primitives += 1;
+                self.builder.count_skipped_primitives(1);
+                continue;
+            }
+            if prim.get(&gltf::Semantic::Positions).is_none() {
+                self.report.skipped_primitives += 1;
+                self.builder.count_skipped_primitives(1);
+                continue;
+            }
+            let (material, uv_spec) = self.material(prim.material())?;
+            let buffers = self.buffers;
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
+            let positions: Vec<Vec3> = match reader.read_positions() {
+                Some(it) => it.map(Vec3::from).collect(),
+                None => {
+                    return Err(self.err(format!(
+                        "mesh `{mesh_name}`: POSITION accessor lies outside its buffer"
+                    )));
+                }
+            };
+            let normals: Option<Vec<Vec3>> = reader
+                .read_normals()
+                .map(|it| it.map(Vec3::from).collect::<Vec<_>>())
+                .filter(|n| n.len() == positions.len());
+            let mut uvs: Option<Vec<Vec2>> = reader
+                .read_tex_coords(uv_spec.set)
+                .map(|t| t.into_f32().map(Vec2::from).collect::<Vec<_>>())
+                .filter(|t| t.len() == positions.len());
+            if let (Some(uvs), Some((offset, rotation, scale))) = (uvs.as_mut(), uv_spec.transform)
+            {
+                let (s, c) = rotation.sin_cos();
+                for uv in uvs.iter_mut() {
+                    let (x, y) = (uv.x * scale[0], uv.y * scale[1]);
+                    *uv = Vec2::new(c * x + s * y + offset[0], -s * x + c * y + offset[1]);
+                }
+            }
+            let raw: Vec<u32> = match prim.indices() {
+                Some(_) => match reader.read_indices() {
+                    Some(i) => i.into_u32().collect(),
+                    None => {
+                        return Err(self.err(format!(
+                            "mesh `{mesh_name}`: index accessor lies outside its buffer"
+                        )));
+                    }
+                },
+                None => (0..positions.len() as u32).collect(),
+            };
+            let indices = triangle_list(mode, &raw);
+            if let Some(&bad) = indices.iter().find(|&&i| i as usize >= positions.len()) {
+                return Err(self.err(format!(
+                    "mesh `{mesh_name}`: index {bad} is past its {} vertices",
+                    positions.len()
+                )));
+            }
+            self.report.primitives += 1;
+            self.report.triangles += indices.len() / 3;
+            self.builder.add_mesh(
+                &mesh_name,
+                &positions,
+                normals.as_deref(),
+                uvs.as_deref(),
+                &indices,
+                world,
+                material,
+            )?;
+        }
+        Ok(())
+    }
+
+    /// The builder material of a glTF material, created on first use.
+    fn material(&mut self, m: gltf::Material) -> Result<(u32, UvSpec), SceneError> {
+        if let Some(&v) = self.materials.get(&m.index()) {
+            return Ok(v);
+        }
+        let mut uv = UvSpec {
+            set: 0,
+            transform: None,
+        };
+        let mat = match m.index() {
+            None => Material::default(),
+            Some(i) => {
+                let name = m
+                    .name()
+                    .map(str::to_string)
+                    .unwrap_or_else(|| format!("material {i}"));
+                let pbr = m.pbr_metallic_roughness();
+                // One uv set and transform per material: those of the first texture that has one.
+                let infos = [
+                    pbr.base_color_texture(),
+                    m.emissive_texture(),
+                    pbr.metallic_roughness_texture(),
+                ];
+                if let Some(info) = infos.iter().flatten().next() {
+                    uv.set = info.tex_coord();
+                    if let Some(t) = info.texture_transform() {
+                        uv.set = t.tex_coord().unwrap_or(uv.set);
+                        uv.transform = Some((t.offset(), t.rotation(), t.scale()));
+                    }
+                }
+                if infos.iter().flatten().any(|t| t.tex_coord() != uv.set) {
+                    self.report.warn(format!(
+                        "material `{name}`: textures on different uv sets; all use TEXCOORD_{}",
+                        uv.set
+                    ));
+                }
+                let base_color_texture = pbr
+                    .base_color_texture()
+                    .map(|t| self.texture(&t.texture(), true))
+                    .transpose()?;
+                let metallic_roughness_texture = pbr
+                    .metallic_roughness_texture()
+                    .map(|t| self.texture(&t.texture(), false))
+                    .transpose()?;
+                let emission_texture = m
+                    .emissive_texture()
+                    .map(|t| self.texture(&t.texture(), true))
+                    .transpose()?;
+                let bc = pbr.base_color_factor();
+                let strength = m.emissive_strength().unwrap_or(1.0);
+                let emission = Vec3::from(m.emissive_factor()) * strength;
+                if !emission.is_finite() || emission.min_element() < 0.0 {
+                    return Err(SceneError::BadEmission {
+                        what: format!("material `{name}` (emissiveFactor × emissive strength)"),
+                        value: format!("{:?}", emission.to_array()),
+                    });
+                }
+                for (ext, what) in [
+                    ("KHR_materials_transmission", "transmission"),
+                    ("KHR_materials_clearcoat", "clearcoat"),
+                    ("KHR_materials_sheen", "sheen"),
+                    ("KHR_materials_volume", "volume"),
+                    ("KHR_materials_pbrSpecularGlossiness", "specular-glossiness"),
+                ] {
+                    if m.extension_value(ext).is_some()
+                        || (ext == "KHR_materials_transmission" && m.transmission().is_some())
+                    {
+                        self.report.warn(format!(
+                            "material `{name}`: {what} ignored (read as opaque metallic-roughness)"
+                        ));
+                    }
+                }
+                if m.alpha_mode() != gltf::material::AlphaMode::Opaque {
+                    self.report
+                        .warn(format!("material `{name}`: alpha mode ignored (opaque)"));
+                }
+                let specular = m.specular();
+                if specular.as_ref().is_some_and(|s| {
+                    s.specular_texture().is_some() || s.specular_color_factor() != [1.0; 3]
+                }) {
+                    self.report.warn(format!(
+                        "material `{name}`: specular texture and colour ignored (factor used)"
+                    ));
+                }
+                Material {
+                    name,
+                    base_color: Vec3::new(bc[0], bc[1], bc[2]),
+                    base_color_texture,
+                    metallic: pbr.metallic_factor(),
+                    roughness: pbr.roughness_factor(),
+                    metallic_roughness_texture,
+                    specular: specular.map_or(1.0, |s| s.specular_factor()),
+                    double_sided: m.double_sided(),
+                    emission,
+                    emission_texture,
+                }
+            }
+        };
+        let id = self.builder.add_material(mat)?;
+        self.materials.insert(m.index(), (id, uv));
+        Ok((id, uv))
+    }
+
+    fn texture(&mut self, tex: &gltf::Texture, srgb: bool) -> Result<Arc<Texture>, SceneError> {
+        let image = tex.source();
+        let key = (image.index(), srgb);
+        if let Some(t) = self.textures.get(&key) {
+            return Ok(t.clone());
+        }
+        let data = gltf::image::Data::from_source(image.source(), Some(self.base), self.buffers)
+            .map_err(|e| self.err(format!("image {}: {e}", image.index())))?;
+        let t = Arc::new(
+            convert_image(&data, srgb)
+                .map_err(|e| self.err(format!("image {}: {e}", image.index())))?,
+        );
+        self.textures.insert(key, t.clone());
+        Ok(t)
+    }
+
+    fn add_light(
+        &mut self,
+        node: &gltf::Node,
+        light: &gltf::khr_lights_punctual::Light,
+        world: Mat4,
+    ) -> Result<(), SceneError> {
+        use gltf::khr_lights_punctual::Kind;
+        let name = light
+            .name()
+            .or(node.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("light {}", light.index()));
+        let power = Vec3::from(light.color()) * light.intensity();
+        if !power.is_finite() || power.min_element() < 0.0 {
+            return Err(SceneError::BadEmission {
+                what: format!("light `{name}` (color × intensity)"),
+                value: format!("{:?}", power.to_array()),
+            });
+        }
+        let radius = match extras_number(node.extras(), "radius")
+            .or_else(|| extras_number(light.extras(), "radius"))
+        {
+            None => 0.0,
+            Some(Ok(r)) if r.is_finite() && r >= 0.0 => r,
+            Some(Ok(r)) => {
+                return Err(SceneError::BadLight {
+                    what: name,
+                    message: format!("radius {r} (must be finite and >= 0)"),
+                });
+            }
+            Some(Err(e)) => {
+                return Err(SceneError::BadLight {
+                    what: name,
+                    message: e,
+                });
+            }
+        };
+        if light.range().is_some() {
+            self.report
+                .warn("punctual light `range` ignored (inverse-square falloff everywhere)".into());
+        }
+        let position = world.transform_point3(Vec3::ZERO);
+        let axis = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let spot = match light.kind() {
+            Kind::Directional => {
+                self.builder.add_distant_light(-axis, power)?;
+                self.report.distant_lights += 1;
+                return Ok(());
+            }
+            Kind::Point => None,
+            Kind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                if axis == Vec3::ZERO || !axis.is_finite() {
+                    return Err(SceneError::BadLight {
+                        what: name,
+                        message: "spot light with a degenerate node transform".into(),
+                    });
+                }
+                let outer = outer_cone_angle.clamp(0.0, PI / 2.0);
+                let inner = inner_cone_angle.clamp(0.0, outer);
+                Some(SpotCone {
+                    direction: axis,
+                    cos_inner: inner.cos(),
+                    cos_outer: outer.cos(),
+                })
+            }
+        };
+        if radius > 0.0 {
+            self.builder.add_sphere_light(
+                position,
+                radius,
+                power / (PI * radius * radius),
+                spot,
+            )?;
+            self.report.sphere_lights += 1;
+        } else {
+            self.builder.add_point_light(position, power, spot)?;
+            if spot.is_some() {
+                self.report.spot_lights += 1;
+            } else {
+                self.report.point_lights += 1;
+            }
+        }
+        Ok(())
+    }
+
+    fn add_camera(
+        &mut self,
+        node: &gltf::Node,
+        camera: &gltf::Camera,
+        world: Mat4,
+    ) -> Result<(), SceneError> {
+        let name = camera
+            .name()
+            .or(node.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("camera {}", camera.index()));
+        let gltf::camera::Projection::Perspective(p) = camera.projection() else {
+            self.report
+                .warn(format!("orthographic camera `{name}` ignored"));
+            return Ok(());
+        };
+        let yfov = p.yfov();
+        if !(yfov > 0.0 && yfov < PI) {
+            return Err(self.err(format!("camera `{name}`: yfov {yfov} is not in (0, π)")));
+        }
+        let aspect = p
+            .aspect_ratio()
+            .filter(|a| a.is_finite() && *a > 0.0)
+            .unwrap_or(1.0);
+        let height = DEFAULT_CAMERA_HEIGHT;
+        let width = ((height as f32 * aspect).round() as u32).clamp(1, 16384);
+        let eye = world.transform_point3(Vec3::ZERO);
+        let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
+        let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
+        if !eye.is_finite() || forward == Vec3::ZERO || forward.cross(up).length_squared() < 1e-12 {
+            return Err(self.err(format!("camera `{name}`: degenerate node transform")));
+        }
+        self.builder.add_camera(Camera::look_at(
+            &name,
+            eye,
+            eye + forward,
+            up,
+            yfov,
+            width,
+            height,
+        ));
+        self.report.cameras += 1;
+        Ok(())
+    }
+}
+
+/// Triangle-list indices from a primitive's indices in its drawing mode.
+fn triangle_list(mode: gltf::mesh::Mode, idx: &[u32]) -> Vec<u32> {
+    use gltf::mesh::Mode;
+    match mode {
+        Mode::TriangleStrip => (0..idx.len().saturating_sub(2))
+            .flat_map(|i| {
+                if i % 2 == 0 {
+                    [idx[i], idx[i + 1], idx[i + 2]]
+                } else {
+                    [idx[i + 1], idx[i], idx[i + 2]]
+                }
+            })
+            .collect(),
+        Mode::TriangleFan => (1..idx.len().saturating_sub(1))
+            .flat_map(|i| [idx[i], idx[i + 1], idx[0]])
+            .collect(),
+        _ => idx[..idx.len() / 3 * 3].to_vec(),
+    }
+}
+
+/// A decoded glTF image as a linear RGBA texture (grey images replicate to RGB).
+fn convert_image(img: &gltf::image::Data, srgb: bool) -> Result<Texture, String> {
+    use gltf::image::Format;
+    let (w, h) = (img.width, img.height);
+    let n = w as usize * h as usize;
+    if n == 0 {
+        return Err("empty image".into());
+    }
+    let lut: Vec<f32> = (0..256)
+        .map(|i| {
+            if srgb {
+                srgb_to_linear(i as f32 / 255.0)
+            } else {
+                i as f32 / 255.0
+            }
+        })
+        .collect();
+    let c8 = |v: u8| lut[v as usize];
+    let c16 = |b: &[u8]| {
+        let v = u16::from_ne_bytes([b[0], b[1]]) as f32 / 65535.0;
+        if srgb { srgb_to_linear(v) } else { v }
+    };
+    let a16 = |b: &[u8]| u16::from_ne_bytes([b[0], b[1]]) as f32 / 65535.0;
+    let f32c = |b: &[u8]| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]);
+    let (channels, bytes_per) = match img.format {
+        Format::R8 => (1, 1),
+        Format::R8G8 => (2, 1),
+        Format::R8G8B8 => (3, 1),
+        Format::R8G8B8A8 => (4, 1),
+        Format::R16 => (1, 2),
+        Format::R16G16 => (2, 2),
+        Format::R16G16B16 => (3, 2),
+        Format::R16G16B16A16 => (4, 2),
+        Format::R32G32B32FLOAT => (3, 4),
+        Format::R32G32B32A32FLOAT => (4, 4),
+    };
+    let stride = channels * bytes_per;
+    if img.pixels.len() < n * stride {
+        return Err(format!(
+            "{} bytes of pixel data for {w}×{h} {:?}",
+            img.pixels.len(),
+            img.format
+        ));
+    }
+    let texels = img.pixels[..n * stride]
+        .chunks_exact(stride)
+        .map(|p| {
+            let ch = |k: usize| &p[k * bytes_per..(k + 1) * bytes_per];
+            let v = |k: usize| match bytes_per {
+                1 => c8(ch(k)[0]),
+                2 => c16(ch(k)),
+                _ => f32c(ch(k)),
+            };
+            let a = |k: usize| match bytes_per {
+                1 => ch(k)[0] as f32 / 255.0,
+                2 => a16(ch(k)),
+                _ => f32c(ch(k)),
+            };
+            match channels {
+                1 => Vec4::new(v(0), v(0), v(0), 1.0),
+                2 => Vec4::new(v(0), v(0), v(0), a(1)),
+                3 => Vec4::new(v(0), v(1), v(2), 1.0),
+                _ => Vec4::new(v(0), v(1), v(2), a(3)),
+            }
+        })
+        .collect();
+    Ok(Texture::new(w, h, texels))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::light::LightShape;
+    use serde_json::{Value, json};
+    use std::path::PathBuf;
+
+    fn err(r: Result<Scene, SceneError>) -> SceneError {
+        match r {
+            Ok(_) => panic!("expected an error"),
+            Err(e) => e,
+        }
+    }
+
+    fn base64(data: &[u8]) -> String {
+        const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+        let mut out = String::new();
+        for c in data.chunks(3) {
+            let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
+            let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
+            for k in 0..4 {
+                if k <= c.len() {
+                    out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
+                } else {
+                    out.push('=');
+                }
+            }
+        }
+        out
+    }
+
+    /// Little-endian bytes of f32s.
+    fn f32_bytes(v: &[f32]) -> Vec<u8> {
+        v.iter().flat_map(|x| x.to_le_bytes()).collect()
+    }
+
+    fn temp_path(name: &str) -> PathBuf {
+        let dir =
+            std::env::temp_dir().join(format!("render-core-gltf-tests-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    /// Writes `doc` as a .gltf whose buffer 0 holds `bin` as a base64 data URI.
+    fn write_gltf(name: &str, mut doc: Value, bin: &[u8]) -> PathBuf {
+        if !bin.is_empty() {
+            doc["buffers"] = json!([{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(bin)) }]);
+        }
+        let path = temp_path(name);
+        std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+        path
+    }
+
+    /// One triangle (0,0,0), (1,0,0), (0,1,0) with u16 indices, plus UVs: accessors 0
+    /// (positions), 1 (indices), 2 (uvs).
+    fn triangle_doc(positions: [f32; 9]) -> (Value, Vec<u8>) {
+        let mut bin = f32_bytes(&positions); // 36 bytes
+        bin.extend([0u16, 1, 2, 0].iter().flat_map(|i| i.to_le_bytes())); // 8 bytes (padded)
+        bin.extend(f32_bytes(&[0.25, 0.5, 0.75, 0.5, 0.25, 0.5])); // 24 bytes
+        let doc = json!({
+            "asset": { "version": "2.0" },
+            "scene": 0,
+            "scenes": [{ "nodes": [0] }],
+            "nodes": [{ "mesh": 0 }],
+            "meshes": [{ "name": "tri", "primitives": [{ "attributes": { "POSITION": 0, "TEXCOORD_0": 2 }, "indices": 1 }] }],
+            "bufferViews": [
+                { "buffer": 0, "byteOffset": 0, "byteLength": 36 },
+                { "buffer": 0, "byteOffset": 36, "byteLength": 6 },
+                { "buffer": 0, "byteOffset": 44, "byteLength": 24 }
+            ],
+            "accessors": [
+                { "bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3", "min": [0, 0, 0], "max": [1, 1, 0] },
+                { "bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR" },
+                { "bufferView": 2, "componentType": 5126, "count": 3, "type": "VEC2" }
+            ]
+        });
+        (doc, bin)
+    }
+
+    const TRI: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
+
+    #[test]
+    fn hierarchy_transforms_reach_world_space_and_modes_are_handled() {
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["scenes"] = json!([{ "nodes": [0] }]);
+        doc["nodes"] = json!([
+            { "name": "parent", "translation": [10, 0, 0], "children": [1] },
+            { "name": "child", "scale": [2, 2, 2], "mesh": 0, "children": [2] },
+            { "name": "grandchild", "translation": [0, 0, 1], "mesh": 1 }
+        ]);
+        // Mesh 1: the same vertices non-indexed, plus a POINTS primitive that is skipped.
+        doc["meshes"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({ "primitives": [
+            { "attributes": { "POSITION": 0 } },
+            { "attributes": { "POSITION": 0 }, "mode": 0 }
+        ] }));
+        let path = write_gltf("hierarchy.gltf", doc, &bin);
+        let (scene, report) = load_gltf_with_report(&path, None).unwrap();
+        assert_eq!(scene.triangles.len(), 2);
+        assert_eq!((report.primitives, report.skipped_primitives), (2, 1));
+        assert_eq!(scene.stats.non_triangle_primitives_skipped, 1);
+        let t0 = &scene.triangles[0];
+        assert_eq!(
+            t0.p,
+            [
+                Vec3::new(10.0, 0.0, 0.0),
+                Vec3::new(12.0, 0.0, 0.0),
+                Vec3::new(10.0, 2.0, 0.0)
+            ]
+        );
+        // The grandchild's translation is scaled by its parent: z = 2.
+        let t1 = &scene.triangles[1];
+        assert_eq!(
+            t1.p,
+            [
+                Vec3::new(10.0, 0.0, 2.0),
+                Vec3::new(12.0, 0.0, 2.0),
+                Vec3::new(10.0, 2.0, 2.0)
+            ]
+        );
+        // No normals in the file: flat shading with the geometric normal.
+        assert_eq!(t0.n, [Vec3::Z; 3]);
+        assert_eq!(t0.uv[1], Vec2::new(0.75, 0.5));
+        // No camera: the default framing camera.
+        assert_eq!(scene.camera(None).unwrap().name, "default");
+    }
+
+    #[test]
+    fn strips_and_fans_become_triangle_lists() {
+        use gltf::mesh::Mode;
+        assert_eq!(
+            triangle_list(Mode::TriangleStrip, &[0, 1, 2, 3]),
+            vec![0, 1, 2, 2, 1, 3]
+        );
+        assert_eq!(
+            triangle_list(Mode::TriangleFan, &[0, 1, 2, 3]),
+            vec![1, 2, 0, 2, 3, 0]
+        );
+        assert_eq!(triangle_list(Mode::Triangles, &[0, 1, 2, 3]), vec![0, 1, 2]);
+    }
+
+    #[test]
+    fn punctual_lights_with_radius_become_sphere_lights() {
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
+        doc["extensions"] = json!({ "KHR_lights_punctual": { "lights": [
+            { "type": "point", "color": [1.0, 0.5, 0.25], "intensity": 2.0 },
+            { "type": "point", "intensity": 3.0 },
+            { "type": "spot", "intensity": 1.0, "spot": { "innerConeAngle": 0.2, "outerConeAngle": 0.5 } },
+            { "type": "directional", "color": [1.0, 1.0, 1.0], "intensity": 5.0 }
+        ] } });
+        // Rotation of −90° about x: local −Z points down (−y) and local +Z up (+y).
+        let (s, c) = (-std::f32::consts::FRAC_PI_4).sin_cos();
+        doc["scenes"] = json!([{ "nodes": [0, 1, 2, 3, 4] }]);
+        doc["nodes"] = json!([
+            { "mesh": 0 },
+            { "translation": [0, 3, 0], "extensions": { "KHR_lights_punctual": { "light": 0 } }, "extras": { "radius": 0.01 } },
+            { "translation": [1, 3, 0], "extensions": { "KHR_lights_punctual": { "light": 1 } } },
+            { "translation": [2, 3, 0], "rotation": [s, 0, 0, c], "extensions": { "KHR_lights_punctual": { "light": 2 } } },
+            { "rotation": [s, 0, 0, c], "extensions": { "KHR_lights_punctual": { "light": 3 } } }
+        ]);
+        let path = write_gltf("lights.gltf", doc, &bin);
+        let scene = load_gltf(&path, None).unwrap();
+        assert_eq!(
+            (
+                scene.stats.sphere_lights,
+                scene.stats.point_lights,
+                scene.stats.spot_lights,
+                scene.stats.distant_lights
+            ),
+            (1, 1, 1, 1)
+        );
+        let sphere = scene
+            .lights
+            .iter()
+            .find(|l| matches!(l.shape, LightShape::Sphere { .. }))
+            .unwrap();
+        let LightShape::Sphere { center, radius } = sphere.shape else {
+            unreachable!()
+        };
+        assert_eq!((center, radius), (Vec3::new(0.0, 3.0, 0.0), 0.01));
+        let expect = Vec3::new(2.0, 1.0, 0.5) / (std::f32::consts::PI * 1e-4);
+        assert!((sphere.emission - expect).length() < 1e-3 * expect.length());
+        let spot = scene.lights.iter().find_map(|l| l.spot).unwrap();
+        assert!((spot.direction - Vec3::NEG_Y).length() < 1e-5);
+        assert!(
+            (spot.cos_inner - 0.2f32.cos()).abs() < 1e-6
+                && (spot.cos_outer - 0.5f32.cos()).abs() < 1e-6
+        );
+        let d = scene.distant_lights[0];
+        assert!((d.direction - Vec3::Y).length() < 1e-5);
+        assert_eq!(d.irradiance, Vec3::splat(5.0));
+    }
+
+    #[test]
+    fn emissive_materials_become_lights_and_textures_gate_them() {
+        // Two triangles over a 2×1 emissive texture: black on the left, white on the right.
+        let mut png = Vec::new();
+        image::RgbImage::from_raw(2, 1, vec![0, 0, 0, 255, 255, 255])
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        let (mut doc, mut bin) = triangle_doc(TRI);
+        let png_offset = bin.len();
+        bin.extend_from_slice(&png);
+        while bin.len() % 4 != 0 {
+            bin.push(0);
+        }
+        // Second uv set: the whole triangle at the black texel's centre.
+        let uv2_offset = bin.len();
+        bin.extend(f32_bytes(&[0.25, 0.5, 0.25, 0.5, 0.25, 0.5]));
+        doc["bufferViews"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({ "buffer": 0, "byteOffset": png_offset, "byteLength": png.len() }));
+        doc["bufferViews"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({ "buffer": 0, "byteOffset": uv2_offset, "byteLength": 24 }));
+        doc["accessors"]
+            .as_array_mut()
+            .unwrap()
+            .push(json!({ "bufferView": 4, "componentType": 5126, "count": 3, "type": "VEC2" }));
+        doc["images"] = json!([{ "bufferView": 3, "mimeType": "image/png" }]);
+        doc["textures"] = json!([{ "source": 0 }]);
+        doc["extensionsUsed"] = json!(["KHR_materials_emissive_strength"]);
+        doc["materials"] = json!([
+            { "name": "lamp", "emissiveFactor": [1.0, 0.5, 0.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 4.0 } } },
+            { "name": "screen", "emissiveFactor": [1.0, 1.0, 1.0], "emissiveTexture": { "index": 0 }, "doubleSided": true }
+        ]);
+        doc["meshes"] = json!([{ "primitives": [
+            { "attributes": { "POSITION": 0 }, "indices": 1, "material": 0 },
+            { "attributes": { "POSITION": 0, "TEXCOORD_0": 2 }, "indices": 1, "material": 1 },
+            { "attributes": { "POSITION": 0, "TEXCOORD_0": 3 }, "indices": 1, "material": 1 }
+        ] }]);
+        let path = write_gltf("emissive.gltf", doc, &bin);
+        let scene = load_gltf(&path, None).unwrap();
+        assert_eq!(scene.triangles.len(), 3);
+        assert_eq!(scene.stats.triangle_lights, 2);
+        assert_eq!(scene.stats.black_emissive_triangles, 1);
+        assert_eq!(scene.lights[0].emission, Vec3::new(4.0, 2.0, 0.0));
+        assert!(!scene.lights[0].two_sided);
+        assert!(scene.lights[1].two_sided);
+        // The white texel decodes to linear 1; the triangle's uvs (0.25..0.75) straddle both texels.
+        let m = scene.lights[1].mean_emission;
+        assert!(m.x > 0.2 && m.x < 0.8, "{m}");
+        assert_eq!(scene.triangles[2].light, crate::scene::NO_LIGHT);
+    }
+
+    #[test]
+    fn cameras_are_read_with_their_names_and_selectable() {
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["cameras"] = json!([
+            { "name": "wide", "type": "perspective", "perspective": { "yfov": 1.0, "aspectRatio": 2.0, "znear": 0.01 } },
+            { "type": "perspective", "perspective": { "yfov": 0.5, "znear": 0.01 } }
+        ]);
+        let (s, c) = (std::f32::consts::FRAC_PI_4).sin_cos(); // +90° about y: −Z turns to −X
+        doc["scenes"] = json!([{ "nodes": [0, 1, 2] }]);
+        doc["nodes"] = json!([
+            { "mesh": 0 },
+            { "camera": 0, "translation": [0, 0, 5] },
+            { "name": "side view", "camera": 1, "translation": [5, 0, 0], "rotation": [0, s, 0, c] }
+        ]);
+        let path = write_gltf("cameras.gltf", doc, &bin);
+        let scene = load_gltf(&path, None).unwrap();
+        let cam = scene.camera(None).unwrap();
+        assert_eq!(
+            (cam.name.as_str(), cam.width, cam.height, cam.yfov),
+            ("wide", 1024, 512, 1.0)
+        );
+        assert_eq!(cam.position, Vec3::new(0.0, 0.0, 5.0));
+        assert!((cam.forward - Vec3::NEG_Z).length() < 1e-6 && (cam.up - Vec3::Y).length() < 1e-6);
+        let scene = load_gltf(&path, Some("side view")).unwrap();
+        let cam = scene.camera(None).unwrap();
+        assert_eq!((cam.name.as_str(), cam.width), ("side view", 512));
+        assert!(
+            (cam.forward - Vec3::NEG_X).length() < 1e-5,
+            "{}",
+            cam.forward
+        );
+        assert!(matches!(
+            load_gltf(&path, Some("nope")),
+            Err(SceneError::CameraNotFound(_))
+        ));
+    }
+
+    #[test]
+    fn bad_input_gives_a_clear_error() {
+        let missing = temp_path("does-not-exist.glb");
+        let e = err(load_gltf(&missing, None));
+        assert!(matches!(e, SceneError::Io { .. }), "{e}");
+
+        let garbage = temp_path("garbage.glb");
+        std::fs::write(
+            &garbage,
+            b"glTF\x02\x00\x00\x00 this is not a real file \xff\xfe",
+        )
+        .unwrap();
+        let e = err(load_gltf(&garbage, None));
+        assert!(matches!(e, SceneError::Gltf { .. }), "{e}");
+        let garbage_json = temp_path("garbage.gltf");
+        std::fs::write(&garbage_json, b"{ \"asset\": ").unwrap();
+        assert!(matches!(
+            load_gltf(&garbage_json, None),
+            Err(SceneError::Gltf { .. })
+        ));
+
+        let (doc, bin) = triangle_doc([0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0, 0.0, 1.0, 0.0]);
+        let e = err(load_gltf(&write_gltf("nan.gltf", doc, &bin), None));
+        assert!(matches!(e, SceneError::NonFiniteVertex { .. }), "{e}");
+
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["materials"] = json!([{ "name": "bad", "emissiveFactor": [1.0, -1.0, 0.0] }]);
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+        let e = err(load_gltf(&write_gltf("negative.gltf", doc, &bin), None));
+        assert!(matches!(e, SceneError::BadEmission { .. }), "{e}");
+        assert!(e.to_string().contains("bad"), "{e}");
+
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["materials"] = json!([{ "emissiveFactor": [1.0, 1.0, 1.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": -2.0 } } }]);
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+        assert!(matches!(
+            load_gltf(&write_gltf("negative2.gltf", doc, &bin), None),
+            Err(SceneError::BadEmission { .. })
+        ));
+
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["extensions"] = json!({ "KHR_lights_punctual": { "lights": [{ "type": "point", "intensity": -1.0 }] } });
+        doc["nodes"] =
+            json!([{ "mesh": 0 }, { "extensions": { "KHR_lights_punctual": { "light": 0 } } }]);
+        doc["scenes"] = json!([{ "nodes": [0, 1] }]);
+        assert!(matches!(
+            load_gltf(&write_gltf("negative3.gltf", doc, &bin), None),
+            Err(SceneError::BadEmission { .. })
+        ));
+
+        let empty = write_gltf(
+            "empty.gltf",
+            json!({ "asset": { "version": "2.0" }, "scenes": [{ "nodes": [] }] }),
+            &[],
+        );
+        let e = err(load_gltf(&empty, None));
+        assert!(matches!(e, SceneError::Empty), "{e}");
+
+        let lights_only = json!({
+            "asset": { "version": "2.0" },
+            "extensions": { "KHR_lights_punctual": { "lights": [{ "type": "point", "intensity": 1.0 }] } },
+            "nodes": [{ "extensions": { "KHR_lights_punctual": { "light": 0 } } }],
+            "scenes": [{ "nodes": [0] }]
+        });
+        let e = err(load_gltf(
+            &write_gltf("lights-only.gltf", lights_only, &[]),
+            None,
+        ));
+        assert!(e.to_string().contains("no triangles"), "{e}");
+
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
+        doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
+        let e = err(load_gltf(&write_gltf("draco.gltf", doc, &bin), None));
+        assert!(e.to_string().contains("KHR_draco_mesh_compression"), "{e}");
+
+        // An index past the vertex array, and an accessor past its buffer.
+        let (mut doc, mut bin) = triangle_doc(TRI);
+        bin[36..38].copy_from_slice(&7u16.to_le_bytes());
+        doc["accessors"][1]["max"] = json!([7]);
+        let e = err(load_gltf(&write_gltf("bad-index.gltf", doc, &bin), None));
+        assert!(matches!(e, SceneError::Gltf { .. }), "{e}");
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["accessors"][0]["count"] = json!(300);
+        let e = err(load_gltf(&write_gltf("short-buffer.gltf", doc, &bin), None));
+        assert!(matches!(e, SceneError::Gltf { .. }), "{e}");
+
+        // Every message is one line.
+        for p in [&missing, &garbage, &garbage_json, &empty] {
+            let e = err(load_gltf(p, None));
+            eprintln!("{e}");
+            assert!(!e.to_string().contains('\n'), "{e}");
+        }
+    }
+
+    fn shared_scene(rel: &str) -> Option<PathBuf> {
+        let p = PathBuf::from(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../../shared/scenes/"
+        ))
+        .join(rel);
+        if p.exists() {
+            Some(p)
+        } else {
+            eprintln!("skipped: {} is not present", p.display());
+            None
+        }
+    }
+
+    #[test]
+    fn bisml_cornell_loads_with_its_sphere_lights() {
+        let Some(path) = shared_scene("bisml_cornell/bisml_cornell.glb") else {
+            return;
+        };
+        let scene = load_gltf(&path, None).unwrap();
+        assert_eq!(scene.stats.sphere_lights, 1494);
+        assert_eq!(scene.stats.point_lights + scene.stats.triangle_lights, 0);
+        assert_eq!(
+            scene.triangles.len() + scene.stats.degenerate_triangles_skipped,
+            119_461
+        );
+        assert!(scene.stats.degenerate_triangles_skipped < 10);
+        for l in &scene.lights {
+            let LightShape::Sphere { radius, .. } = l.shape else {
+                panic!("not a sphere light")
+            };
+            assert_eq!(radius, 0.001);
+        }
+        // The right wall's 831 lights have radiance (300, 180, 225).
+        let right = scene
+            .lights
+            .iter()
+            .filter(|l| {
+                (l.emission - Vec3::new(300.0, 180.0, 225.0))
+                    .abs()
+                    .max_element()
+                    < 0.01
+            })
+            .count();
+        assert_eq!(right, 831);
+        let cam = scene.camera(None).unwrap();
+        assert!((cam.position - Vec3::new(0.0, 1.0, 6.8)).length() < 1e-5);
+        assert!((cam.yfov - 19.5f32.to_radians()).abs() < 1e-5);
+        assert_eq!((cam.width, cam.height), (512, 512));
+    }
+
+    #[test]
+    fn toycar_lights_only_where_its_emissive_texture_is_not_black() {
+        let Some(path) = shared_scene("car_toycar/ToyCar.glb") else {
+            return;
+        };
+        let (scene, report) = load_gltf_with_report(&path, None).unwrap();
+        let s = &scene.stats;
+        eprintln!("{s:?}\n{:?}", report.warnings);
+        assert_eq!(
+            scene.triangles.len() + s.degenerate_triangles_skipped,
+            108_936
+        );
+        assert!(
+            s.triangle_lights > 0 && s.black_emissive_triangles > 0,
+            "{s:?}"
+        );
+        assert!(s.triangle_lights < 88_837 / 2, "{s:?}");
+        assert_eq!(scene.cameras.len(), 8);
+        assert!(
+            report.warnings.iter().any(|w| w.contains("transmission")),
+            "{:?}",
+            report.warnings
+        );
+    }
+}
