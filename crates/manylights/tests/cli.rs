@@ -1,0 +1,193 @@
+//! The command line as a user meets it: outputs, determinism and every kind of bad input.
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn manylights(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("manylights-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+const SCENE: &str = "builtin:glossy-spheres?lights=64";
+
+fn render_to(dir: &Path, name: &str, extra: &[&str]) -> Output {
+    let out = dir.join(format!("{name}.exr"));
+    let mut args = vec![
+        "render",
+        SCENE,
+        "--strategy",
+        "power+bsdf",
+        "--spp",
+        "2",
+        "--width",
+        "32",
+        "--height",
+        "24",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ];
+    args.extend_from_slice(extra);
+    manylights(&args)
+}
+
+#[test]
+fn render_writes_exr_png_json_and_aux() {
+    let dir = temp_dir("outputs");
+    let png = dir.join("a.png");
+    let o = render_to(&dir, "a", &["--png", png.to_str().unwrap(), "--aux"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(dir.join("a.exr").is_file() && png.is_file() && dir.join("a.mask.png").is_file());
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("a.json")).unwrap()).unwrap();
+    assert_eq!(meta["spp"], 2);
+    assert_eq!(meta["strategy"], "power+bsdf");
+    assert_eq!(meta["rays"]["camera"], 2 * 32 * 24);
+    assert!(meta["rays"]["shadow"].as_u64().unwrap() > 0);
+    assert!(meta["wall_seconds"].as_f64().unwrap() > 0.0);
+    let (w, h, px) = render_core::output::read_exr(&dir.join("a.exr")).unwrap();
+    assert_eq!((w, h, px.len()), (32, 24, 32 * 24));
+    assert!(px.iter().any(|p| p.max_element() > 0.0), "the image is lit");
+}
+
+#[test]
+fn exr_bytes_do_not_depend_on_thread_count() {
+    let dir = temp_dir("threads");
+    assert!(
+        render_to(&dir, "one", &["--threads", "1", "--seed", "5"])
+            .status
+            .success()
+    );
+    assert!(
+        render_to(&dir, "two", &["--threads", "2", "--seed", "5"])
+            .status
+            .success()
+    );
+    assert_eq!(
+        std::fs::read(dir.join("one.exr")).unwrap(),
+        std::fs::read(dir.join("two.exr")).unwrap()
+    );
+}
+
+#[test]
+fn time_budget_records_the_spp_reached() {
+    let dir = temp_dir("budget");
+    let out = dir.join("t.exr");
+    let o = manylights(&[
+        "render",
+        SCENE,
+        "--time-budget",
+        "0.5",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("t.json")).unwrap()).unwrap();
+    assert!(meta["spp"].as_u64().unwrap() >= 1);
+    assert_eq!(meta["time_budget_s"], 0.5);
+}
+
+/// Runs a command that must fail with one clear line and leave no output file behind.
+fn assert_clean_failure(dir: &Path, args: &[&str], expect: &str) {
+    let o = manylights(args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success(), "{args:?} should fail");
+    assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "{args:?}: one line expected, got {err}");
+    assert!(
+        lines[0].starts_with("error:") && lines[0].to_lowercase().contains(expect),
+        "{args:?}: {err}"
+    );
+    let left: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .flatten()
+        .map(|e| e.file_name())
+        .collect();
+    assert!(left.is_empty(), "{args:?} left files: {left:?}");
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    let dir = temp_dir("bad");
+    let inputs = temp_dir("bad-inputs");
+    let out = dir.join("x.exr");
+    let out = out.to_str().unwrap();
+    let garbage = inputs.join("garbage.glb");
+    std::fs::write(&garbage, b"this is not a glTF file at all").unwrap();
+    let missing = inputs.join("missing.gltf");
+    let r = |scene: &str, extra: &[&str]| {
+        let mut a = vec![
+            "render", scene, "--spp", "1", "--width", "8", "--height", "8", "--quiet", "--out", out,
+        ];
+        a.extend_from_slice(extra);
+        a.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (r(missing.to_str().unwrap(), &[]), "missing.gltf"),
+        (r(garbage.to_str().unwrap(), &[]), "garbage.glb"),
+        (
+            r(SCENE, &["--strategy", "no-such-strategy"]),
+            "unknown strategy",
+        ),
+        (r("builtin:no-such-scene", &[]), "no-such-scene"),
+        (r("builtin:glossy-spheres?lightz=4", &[]), "lightz"),
+        (r("builtin:glossy-spheres?lights=many", &[]), "lights"),
+        (
+            vec![
+                "render".into(),
+                SCENE.into(),
+                "--spp".into(),
+                "0".into(),
+                "--quiet".into(),
+                "--out".into(),
+                out.into(),
+            ],
+            "spp",
+        ),
+        (
+            vec![
+                "render".into(),
+                SCENE.into(),
+                "--spp".into(),
+                "1".into(),
+                "--quiet".into(),
+                "--out".into(),
+                "/nonexistent-dir/x.exr".into(),
+            ],
+            "nonexistent-dir",
+        ),
+    ];
+    for (args, expect) in cases {
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        assert_clean_failure(&dir, &args, expect);
+    }
+}
+
+#[test]
+fn info_and_scenes_list() {
+    let o = manylights(&["info", SCENE]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("64 sphere"), "{text}");
+    let o = manylights(&["scenes"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        text.contains("builtin:glossy-spheres") && text.contains("builtin:diffuse-quads"),
+        "{text}"
+    );
+}
