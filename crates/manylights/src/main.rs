@@ -31,6 +31,18 @@ enum Command {
     Scenes,
     /// List the strategies.
     Strategies,
+    /// Error of an EXR against a reference EXR: relMSE and MSE, over all pixels and, with
+    /// --mask (a render's `.mask.png`), over the pixels whose camera ray sees no light.
+    Compare {
+        image: std::path::PathBuf,
+        reference: std::path::PathBuf,
+        /// Light mask written by `render --aux` (non-black = the camera sees a light there).
+        #[arg(long)]
+        mask: Option<std::path::PathBuf>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn main() -> ExitCode {
@@ -42,6 +54,12 @@ fn main() -> ExitCode {
             list_scenes();
             Ok(())
         }
+        Command::Compare {
+            image,
+            reference,
+            mask,
+            json,
+        } => compare(&image, &reference, mask.as_deref(), json),
         Command::Strategies => {
             for s in samplers::strategies() {
                 println!(
@@ -118,5 +136,46 @@ fn info(spec: &str, json: bool) -> anyhow::Result<()> {
                 .join(", ")
         }
     );
+    Ok(())
+}
+
+fn compare(
+    image: &std::path::Path,
+    reference: &std::path::Path,
+    mask: Option<&std::path::Path>,
+    json: bool,
+) -> anyhow::Result<()> {
+    use render_core::metrics::error_metrics;
+    let (w, h, x) = render_core::output::read_exr(image).map_err(anyhow::Error::msg)?;
+    let (rw, rh, r) = render_core::output::read_exr(reference).map_err(anyhow::Error::msg)?;
+    if (w, h) != (rw, rh) {
+        anyhow::bail!(
+            "{} is {w}x{h} but the reference {} is {rw}x{rh}",
+            image.display(),
+            reference.display()
+        );
+    }
+    let all = error_metrics(&x, &r, None);
+    let unlit = match mask {
+        Some(m) => {
+            let unlit = render_core::output::read_mask_png(m, w, h).map_err(anyhow::Error::msg)?;
+            Some(error_metrics(&x, &r, Some(&unlit)))
+        }
+        None => None,
+    };
+    if json {
+        println!("{}", serde_json::json!({ "all": all, "unlit": unlit }));
+    } else {
+        println!(
+            "all pixels    relMSE {:.6e}  MSE {:.6e}  ({} px)",
+            all.rel_mse, all.mse, all.pixels
+        );
+        if let Some(u) = unlit {
+            println!(
+                "unlit pixels  relMSE {:.6e}  MSE {:.6e}  ({} px)",
+                u.rel_mse, u.mse, u.pixels
+            );
+        }
+    }
     Ok(())
 }

@@ -191,3 +191,38 @@ fn info_and_scenes_list() {
         "{text}"
     );
 }
+
+#[test]
+fn compare_reports_error_against_a_reference() {
+    let dir = temp_dir("compare");
+    assert!(
+        render_to(&dir, "a", &["--seed", "1", "--aux"])
+            .status
+            .success()
+    );
+    assert!(render_to(&dir, "b", &["--seed", "2"]).status.success());
+    let (a, b, mask) = (dir.join("a.exr"), dir.join("b.exr"), dir.join("a.mask.png"));
+    let o = manylights(&[
+        "compare",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--mask",
+        mask.to_str().unwrap(),
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        v["all"]["rel_mse"].as_f64().unwrap() > 0.0,
+        "independent renders differ"
+    );
+    assert!(v["unlit"]["pixels"].as_u64().unwrap() <= v["all"]["pixels"].as_u64().unwrap());
+    let o = manylights(&[
+        "compare",
+        a.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--json",
+    ]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["all"]["rel_mse"].as_f64().unwrap(), 0.0);
+}

@@ -16,6 +16,7 @@ pub mod frame;
 pub mod gltf_loader;
 pub mod light;
 pub mod material;
+pub mod metrics;
 pub mod microfacet;
 pub mod output;
 pub mod render;

@@ -110,3 +110,18 @@ pub fn write_json(path: &Path, value: &serde_json::Value) -> Result<(), String> 
         std::fs::write(tmp, text + "\n").map_err(|e| e.to_string())
     })
 }
+
+/// Reads a light mask PNG written by [`write_mask_png`]: true where the camera sees *no* light.
+pub fn read_mask_png(path: &Path, width: u32, height: u32) -> Result<Vec<bool>, String> {
+    let img = image::open(path)
+        .map_err(|e| format!("cannot read mask {}: {e}", path.display()))?
+        .to_luma8();
+    if img.dimensions() != (width, height) {
+        return Err(format!(
+            "mask {} is {:?}, expected {width}x{height}",
+            path.display(),
+            img.dimensions()
+        ));
+    }
+    Ok(img.pixels().map(|p| p.0[0] == 0).collect())
+}

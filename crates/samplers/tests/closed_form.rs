@@ -6,7 +6,16 @@ use render_core::scene::SceneBuilder;
 use samplers::{StrategyOptions, create};
 use std::f64::consts::PI;
 
-const STRATEGIES: [&str; 8] = ["uniform", "power", "bsdf", "power+bsdf", "tree", "tree+bsdf", "tree-split", "tree-split+bsdf"];
+const STRATEGIES: [&str; 8] = [
+    "uniform",
+    "power",
+    "bsdf",
+    "power+bsdf",
+    "tree",
+    "tree+bsdf",
+    "tree-split",
+    "tree-split+bsdf",
+];
 
 #[test]
 fn sphere_light_over_lambertian_plane() {

@@ -36,7 +36,15 @@ fn baseline_strategies_agree_on_a_mixed_scene() {
         mean > 0.01 && se < 0.01 * mean,
         "the comparison must have power: {mean} ± {se}"
     );
-    for (name, spp) in [("uniform", 256), ("power", 256), ("bsdf", 1024), ("tree", 256), ("tree+bsdf", 256), ("tree-split", 128), ("tree-split+bsdf", 128)] {
+    for (name, spp) in [
+        ("uniform", 256),
+        ("power", 256),
+        ("bsdf", 1024),
+        ("tree", 256),
+        ("tree+bsdf", 256),
+        ("tree-split", 128),
+        ("tree-split+bsdf", 128),
+    ] {
         let r = render_with(&scene, name, spp, 2, 2);
         let failures = compare(&reference, &r, 2, 3.0);
         assert!(
