@@ -18,7 +18,7 @@
 //! frame) enters only through the normalisation D(H) and the early-out for caps entirely below
 //! it: mass of D(C) below the shading horizon is counted (see the README's accuracy table).
 
-use crate::cap::{Cap64, below_horizon};
+use crate::cap::{Cap64, below_horizon, lens_area_exact};
 use crate::fit::{self, CellCaps, CellSamples};
 use crate::table::{Lookup, Table};
 use crate::{CapIntegral, LobeIntegral};
@@ -78,6 +78,11 @@ pub struct LtcLobe {
     g: DMat3,
     det_g: f64,
     det_minv: f64,
+    /// Normal of the image of the shading horizon in the LTC space, and D(H).
+    n_h: DVec3,
+    mass_h: f64,
+    /// Clip at the shading horizon as well as at the LTC's own (default true).
+    pub clip_shading_horizon: bool,
     scale: f64,
     albedo: f32,
 }
@@ -100,6 +105,9 @@ impl LtcLobe {
             g: m.transpose() * m,
             det_g: det_m * det_m,
             det_minv: minv.determinant().abs(),
+            n_h: n.normalize(),
+            mass_h,
+            clip_shading_horizon: true,
             scale,
             albedo,
         }
@@ -121,17 +129,22 @@ impl LtcLobe {
         (self.scale * self.ltc_density(w.as_dvec3())) as f32
     }
 
-    /// D(C): the LTC mass of a cap (horizon-clipped only at the LTC's own horizon).
+    /// D(C ∩ H): the LTC mass of a cap, clipped at the LTC's own horizon exactly (for the
+    /// equivalent circular cone) and at the shading horizon approximately (solid-angle fraction of
+    /// the equivalent cone above it).
     #[inline]
     pub(crate) fn cap_mass(&self, cap: &Cap64) -> f64 {
         if cap.cos < 0.0 {
-            let comp = Cap64 {
-                axis: -cap.axis,
-                cos: -cap.cos,
-                sin: cap.sin,
-            };
-            return 1.0 - self.cap_mass(&comp);
+            // larger than a hemisphere: the complement, without the shading-horizon clip (the
+            // equivalent-cone fraction is a poor approximation for hemisphere-sized cones)
+            let comp = Cap64 { axis: -cap.axis, cos: -cap.cos, sin: cap.sin };
+            return (1.0 - self.cap_mass_ltc(&comp, false)).clamp(0.0, self.mass_h);
         }
+        self.cap_mass_ltc(cap, self.clip_shading_horizon)
+    }
+
+    #[inline]
+    fn cap_mass_ltc(&self, cap: &Cap64, clip_shading_horizon: bool) -> f64 {
         if cap.sin <= 0.0 {
             return 0.0;
         }
@@ -172,7 +185,19 @@ impl LtcLobe {
         };
         let c_prime = self.minv * cap.axis;
         let e3 = if e3.dot(c_prime) < 0.0 { -e3 } else { e3 };
-        clipped_sphere_form_factor(e3.z, ff)
+        let clipped = clipped_sphere_form_factor(e3.z, ff);
+        if !clip_shading_horizon || clipped <= 0.0 {
+            return clipped;
+        }
+        // shading horizon: keep the fraction of the equivalent cap on the upper side of the image
+        // of z = 0 (normal n_h in the LTC space); exact when the cap does not cross it
+        let eq = Cap64 { axis: e3, cos: (1.0 - ff).sqrt(), sin: ff.sqrt() };
+        let area = eq.area();
+        if area <= 0.0 {
+            return if e3.dot(self.n_h) >= 0.0 { clipped } else { 0.0 };
+        }
+        let frac = lens_area_exact(&eq, &Cap64 { axis: self.n_h, cos: 0.0, sin: 1.0 }) / area;
+        clipped * frac.clamp(0.0, 1.0)
     }
 
     #[inline]
@@ -482,7 +507,8 @@ mod tests {
     fn cap_mass_exact_when_above_ltc_horizon() {
         // for cones entirely above the LTC horizon the elliptic-cone form factor is exact
         let minv = minv_from_params(-0.5, 0.4, 0.25, 0.1);
-        let lobe = LtcLobe::new(minv, 1.0);
+        let mut lobe = LtcLobe::new(minv, 1.0);
+        lobe.clip_shading_horizon = false;
         let mut rng = SplitMix64::new(3);
         let z = lobe.m * DVec3::Z; // direction of the LTC lobe peak
         let z = z.normalize();
@@ -503,7 +529,8 @@ mod tests {
     fn near_hemisphere_caps_are_continuous() {
         // a sharp lobe: the cone matrix is badly conditioned for caps close to a hemisphere
         let minv = minv_from_params(-0.3, 0.002, 0.0015, 0.0);
-        let lobe = LtcLobe::new(minv, 1.0);
+        let mut lobe = LtcLobe::new(minv, 1.0);
+        lobe.clip_shading_horizon = false;
         let axis = DVec3::new(0.5, 0.5, 0.5f64.sqrt()).normalize();
         let mut prev = None;
         for k in -6..=6 {
@@ -524,6 +551,7 @@ mod tests {
     fn identity_ltc_is_clamped_cosine() {
         let lobe = LtcLobe::new(DMat3::IDENTITY, 1.0);
         let cap = Cap64::new(DVec3::new(0.6, 0.0, 0.8), 0.9);
+        assert!(lobe.clip_shading_horizon);
         let v = lobe.cap_mass(&cap);
         assert!((v - 0.8 * (1.0 - 0.81)).abs() < 1e-9, "{v}");
         assert!((lobe.cap_mass(&Cap64::new(DVec3::Z, -1.0)) - 1.0).abs() < 1e-9);
