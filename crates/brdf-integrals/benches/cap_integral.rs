@@ -38,20 +38,36 @@ fn bench(c: &mut Criterion) {
     g.throughput(criterion::Throughput::Elements(n));
     let lobe = sptd.lobe(wo, alpha);
     g.bench_function("sptd_exact", |b| {
-        b.iter(|| caps.iter().map(|&(a, cs)| lobe.integral(black_box(a), black_box(cs))).sum::<f32>())
+        b.iter(|| {
+            caps.iter()
+                .map(|&(a, cs)| lobe.integral(black_box(a), black_box(cs)))
+                .sum::<f32>()
+        })
     });
     let lobe = sptd_oat.lobe(wo, alpha);
     g.bench_function("sptd_oat_sander", |b| {
-        b.iter(|| caps.iter().map(|&(a, cs)| lobe.integral(black_box(a), black_box(cs))).sum::<f32>())
+        b.iter(|| {
+            caps.iter()
+                .map(|&(a, cs)| lobe.integral(black_box(a), black_box(cs)))
+                .sum::<f32>()
+        })
     });
     let lobe = ltc.lobe(wo, alpha);
     g.bench_function("ltc", |b| {
-        b.iter(|| caps.iter().map(|&(a, cs)| lobe.integral(black_box(a), black_box(cs))).sum::<f32>())
+        b.iter(|| {
+            caps.iter()
+                .map(|&(a, cs)| lobe.integral(black_box(a), black_box(cs)))
+                .sum::<f32>()
+        })
     });
     g.finish();
     let mut g = c.benchmark_group("lobe_setup");
-    g.bench_function("sptd_lobe", |b| b.iter(|| sptd.lobe(black_box(wo), black_box(alpha))));
-    g.bench_function("ltc_lobe", |b| b.iter(|| ltc.lobe(black_box(wo), black_box(alpha))));
+    g.bench_function("sptd_lobe", |b| {
+        b.iter(|| sptd.lobe(black_box(wo), black_box(alpha)))
+    });
+    g.bench_function("ltc_lobe", |b| {
+        b.iter(|| ltc.lobe(black_box(wo), black_box(alpha)))
+    });
     g.finish();
 }
 

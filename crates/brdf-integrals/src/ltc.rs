@@ -137,7 +137,11 @@ impl LtcLobe {
         if cap.cos < 0.0 {
             // larger than a hemisphere: the complement, without the shading-horizon clip (the
             // equivalent-cone fraction is a poor approximation for hemisphere-sized cones)
-            let comp = Cap64 { axis: -cap.axis, cos: -cap.cos, sin: cap.sin };
+            let comp = Cap64 {
+                axis: -cap.axis,
+                cos: -cap.cos,
+                sin: cap.sin,
+            };
             return (1.0 - self.cap_mass_ltc(&comp, false)).clamp(0.0, self.mass_h);
         }
         self.cap_mass_ltc(cap, self.clip_shading_horizon)
@@ -191,12 +195,27 @@ impl LtcLobe {
         }
         // shading horizon: keep the fraction of the equivalent cap on the upper side of the image
         // of z = 0 (normal n_h in the LTC space); exact when the cap does not cross it
-        let eq = Cap64 { axis: e3, cos: (1.0 - ff).sqrt(), sin: ff.sqrt() };
+        let eq = Cap64 {
+            axis: e3,
+            cos: (1.0 - ff).sqrt(),
+            sin: ff.sqrt(),
+        };
         let area = eq.area();
         if area <= 0.0 {
-            return if e3.dot(self.n_h) >= 0.0 { clipped } else { 0.0 };
+            return if e3.dot(self.n_h) >= 0.0 {
+                clipped
+            } else {
+                0.0
+            };
         }
-        let frac = lens_area_exact(&eq, &Cap64 { axis: self.n_h, cos: 0.0, sin: 1.0 }) / area;
+        let frac = lens_area_exact(
+            &eq,
+            &Cap64 {
+                axis: self.n_h,
+                cos: 0.0,
+                sin: 1.0,
+            },
+        ) / area;
         clipped * frac.clamp(0.0, 1.0)
     }
 
@@ -532,13 +551,13 @@ mod tests {
         let mut lobe = LtcLobe::new(minv, 1.0);
         lobe.clip_shading_horizon = false;
         let axis = DVec3::new(0.5, 0.5, 0.5f64.sqrt()).normalize();
-        let mut prev = None;
+        let mut prev: Option<f64> = None;
         for k in -6..=6 {
             let cos = k as f64 * 1e-4;
             let v = lobe.cap_mass(&Cap64::new(axis, cos));
             assert!((0.0..=1.0).contains(&v), "{cos}: {v}");
             if let Some(p) = prev {
-                assert!((v - p as f64).abs() < 1e-3, "{cos}: {v} after {p}");
+                assert!((v - p).abs() < 1e-3, "{cos}: {v} after {p}");
             }
             prev = Some(v);
         }
