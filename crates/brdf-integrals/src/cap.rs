@@ -138,22 +138,25 @@ pub(crate) fn lens_area_exact(a: &Cap64, b: &Cap64) -> f64 {
     area.clamp(0.0, a.area().min(b.area()))
 }
 
-/// Oat–Sander approximation of the intersection area.
+/// Oat–Sander approximation of the intersection area (exact nested / disjoint cases by cosine
+/// tests; the angles are only computed in the smoothstep band).
 #[inline]
 pub(crate) fn lens_area_oat_sander(a: &Cap64, b: &Cap64) -> f64 {
     let cd = a.axis.dot(b.axis).clamp(-1.0, 1.0);
-    let d = cd.acos();
-    let (ra, rb) = (a.angle(), b.angle());
-    let rmin = ra.min(rb);
-    let rmax = ra.max(rb);
-    let small = if ra <= rb { a.area() } else { b.area() };
-    if d <= rmax - rmin {
+    let c_sum = a.cos * b.cos - a.sin * b.sin;
+    let s_sum = a.sin * b.cos + a.cos * b.sin;
+    let c_diff = a.cos * b.cos + a.sin * b.sin;
+    let small = a.area().min(b.area());
+    if cd >= c_diff {
         return small;
     }
-    if d >= ra + rb {
+    if cd <= c_sum && s_sum >= 0.0 {
         return 0.0;
     }
-    let t = ((d - (rmax - rmin)) / (ra + rb - (rmax - rmin))).clamp(0.0, 1.0);
+    let d = cd.acos();
+    let (ra, rb) = (a.angle(), b.angle());
+    let rdiff = (ra - rb).abs();
+    let t = ((d - rdiff) / (ra + rb - rdiff)).clamp(0.0, 1.0);
     let x = 1.0 - t;
     x * x * (3.0 - 2.0 * x) * small
 }
