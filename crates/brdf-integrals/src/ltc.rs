@@ -216,7 +216,10 @@ impl LtcLobe {
                 sin: 1.0,
             },
         ) / area;
-        clipped * frac.clamp(0.0, 1.0)
+        // and stay within the rigorous bounds D(C) − D(below H) ≤ D(C ∩ H) ≤ min(D(C), D(H))
+        let lo = clipped - (1.0 - self.mass_h);
+        let hi = clipped.min(self.mass_h);
+        (clipped * frac.clamp(0.0, 1.0)).max(lo).min(hi)
     }
 
     #[inline]
