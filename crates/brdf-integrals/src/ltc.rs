@@ -15,8 +15,9 @@
 //! the cone is then replaced by the circular cone with the same form factor and axis (sin²σ = ff)
 //! and clipped at the LTC horizon z' = 0 with the closed form for a horizon-clipped sphere.
 //! Caps larger than a hemisphere use the complement. The shading horizon (z = 0 in the local
-//! frame) enters only through the normalisation D(H) and the early-out for caps entirely below
-//! it: mass of D(C) below the shading horizon is counted (see the README's accuracy table).
+//! frame) is handled approximately: the equivalent cone is weighted by its solid-angle fraction on
+//! the upper side of the image of z = 0, clamped to D(C) − D(below H) ≤ D(C ∩ H) ≤ min(D(C), D(H));
+//! caps entirely below the horizon give 0.
 
 use crate::cap::{Cap64, below_horizon, lens_area_exact};
 use crate::fit::{self, CellCaps, CellSamples};
