@@ -414,6 +414,39 @@ impl SceneBuilder {
         self.stats.non_triangle_primitives_skipped += n;
     }
 
+    /// Materials added so far, for composition files that override them after loading a glTF.
+    pub fn materials_mut(&mut self) -> &mut [Material] {
+        &mut self.materials
+    }
+
+    /// Number of materials added so far.
+    pub fn material_count(&self) -> usize {
+        self.materials.len()
+    }
+
+    /// Bounds of the triangles and lights added so far (`None` when empty).
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for t in &self.triangles {
+            for p in t.p {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        for l in &self.lights {
+            let (a, b) = l.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// Forgets the cameras added so far (a composition places its own).
+    pub fn clear_cameras(&mut self) {
+        self.cameras.clear();
+    }
+
     pub fn add_camera(&mut self, camera: Camera) {
         self.cameras.push(camera);
     }
