@@ -1147,6 +1147,17 @@ mod tests {
         assert!((cam.position - Vec3::new(0.0, 1.0, 6.8)).length() < 1e-5);
         assert!((cam.yfov - 19.5f32.to_radians()).abs() < 1e-5);
         assert_eq!((cam.width, cam.height), (512, 512));
+        // The README's camera check: this light lands at raster (82.6, 94.9) of 1024², top left.
+        let d = Vec3::new(-0.999, 1.970, -0.132) - cam.position;
+        let right = cam.forward.cross(cam.up);
+        let tan = (0.5 * cam.yfov).tan();
+        let sx = d.dot(right) / d.dot(cam.forward) / tan;
+        let sy = d.dot(cam.up) / d.dot(cam.forward) / tan;
+        let raster = Vec2::new((sx + 1.0) * 512.0, (1.0 - sy) * 512.0);
+        assert!((raster - Vec2::new(82.6, 94.9)).length() < 0.2, "{raster}");
+        // And the camera's own ray through that raster position points at the light.
+        let dir = cam.ray_direction(raster / 1024.0, 1.0);
+        assert!(dir.dot(d.normalize()) > 1.0 - 1e-6);
     }
 
     #[test]
