@@ -329,3 +329,66 @@ fn grid_lights_fill_rows_and_scale_their_radius() {
         SceneError::BadBuiltinParam { .. }
     ));
 }
+
+/// Uniform light selection, light sampling only: enough to see that light reaches the view.
+struct UniformLights;
+
+impl crate::estimator::DirectLighting for UniformLights {
+    fn name(&self) -> String {
+        "test-uniform".into()
+    }
+
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &crate::estimator::ShadingPoint,
+        rng: &mut crate::rng::SampleStream,
+        ctx: &mut crate::estimator::SampleContext,
+    ) -> Vec3 {
+        let n = scene.lights.len();
+        let i = ((rng.next_f32() * n as f32) as usize).min(n - 1);
+        match scene.lights[i].sample(sp.point(), rng.next_2d()) {
+            Some(s) => sp.shade(scene, &s, ctx.counters) * n as f32 / s.pdf,
+            None => Vec3::ZERO,
+        }
+    }
+}
+
+#[test]
+fn every_builtin_renders_a_lit_image() {
+    use crate::render::{RenderSettings, render};
+    for info in list_builtins() {
+        let scene = load_builtin(&format!("builtin:{}?lights=200", info.name)).unwrap();
+        let camera = scene.camera(None).unwrap();
+        let settings = RenderSettings {
+            width: 32,
+            height: 24,
+            spp: Some(4),
+            seed: 1,
+            time_budget: None,
+            threads: Some(1),
+            camera,
+        };
+        let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
+        // Leave out pixels that see a light directly: the rest is reflected light.
+        let lit: Vec<f32> = r
+            .pixels
+            .iter()
+            .zip(&r.light_fraction)
+            .filter(|(_, f)| **f == 0.0)
+            .map(|(p, _)| crate::light::luminance(*p))
+            .collect();
+        assert!(
+            lit.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "{}",
+            info.name
+        );
+        let mean = lit.iter().sum::<f32>() / lit.len() as f32;
+        let nonzero = lit.iter().filter(|v| **v > 0.0).count() as f32 / lit.len() as f32;
+        assert!(
+            mean > 0.01 && nonzero > 0.3,
+            "{}: mean {mean}, lit fraction {nonzero}",
+            info.name
+        );
+    }
+}
