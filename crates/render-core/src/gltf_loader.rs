@@ -1062,6 +1062,37 @@ mod tests {
             Err(SceneError::BadEmission { .. })
         ));
 
+        // Non-finite emission (1e39 overflows f32), bad radii, a bad camera.
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["materials"] = json!([{ "emissiveFactor": [1.0, 1.0, 1.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 1e39 } } }]);
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+        let e = err(load_gltf(&write_gltf("infinite.gltf", doc, &bin), None));
+        assert!(matches!(e, SceneError::BadEmission { .. }), "{e}");
+        for (i, extras) in [json!({ "radius": -0.5 }), json!({ "radius": "big" })]
+            .into_iter()
+            .enumerate()
+        {
+            let (mut doc, bin) = triangle_doc(TRI);
+            doc["extensions"] = json!({ "KHR_lights_punctual": { "lights": [{ "type": "point", "intensity": 1.0 }] } });
+            doc["nodes"] = json!([{ "mesh": 0 }, { "extensions": { "KHR_lights_punctual": { "light": 0 } }, "extras": extras }]);
+            doc["scenes"] = json!([{ "nodes": [0, 1] }]);
+            let e = err(load_gltf(
+                &write_gltf(&format!("radius{i}.gltf"), doc, &bin),
+                None,
+            ));
+            assert!(matches!(e, SceneError::BadLight { .. }), "{e}");
+        }
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["cameras"] =
+            json!([{ "type": "perspective", "perspective": { "yfov": 4.0, "znear": 0.01 } }]);
+        doc["nodes"] = json!([{ "mesh": 0 }, { "camera": 0 }]);
+        doc["scenes"] = json!([{ "nodes": [0, 1] }]);
+        let e = err(load_gltf(&write_gltf("camera.gltf", doc, &bin), None));
+        assert!(
+            matches!(e, SceneError::Gltf { .. }) && e.to_string().contains("yfov"),
+            "{e}"
+        );
+
         let empty = write_gltf(
             "empty.gltf",
             json!({ "asset": { "version": "2.0" }, "scenes": [{ "nodes": [] }] }),
