@@ -122,6 +122,7 @@ pub fn load_gltf_with_report(
         ));
     }
     select_camera(&mut scene, camera)?;
+    scene.stats.warnings.extend(report.warnings.iter().cloned());
     Ok((scene, report))
 }
 
@@ -1218,6 +1219,7 @@ mod tests {
         );
         assert!(s.triangle_lights < 88_837 / 2, "{s:?}");
         assert_eq!(scene.cameras.len(), 8);
+        assert_eq!(scene.stats.warnings, report.warnings);
         assert!(
             report.warnings.iter().any(|w| w.contains("transmission")),
             "{:?}",
