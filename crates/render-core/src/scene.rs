@@ -28,7 +28,7 @@ pub struct Triangle {
 pub struct SceneStats {
     pub triangles: usize,
     pub degenerate_triangles_skipped: usize,
-    /// Input primitives that are not triangles (points, lines), not loaded.
+    /// Input primitives not loaded: points, lines, or no positions.
     pub non_triangle_primitives_skipped: usize,
     pub triangle_lights: usize,
     pub sphere_lights: usize,
@@ -38,6 +38,8 @@ pub struct SceneStats {
     /// Emissive triangles whose emission averages to zero (not lights).
     pub black_emissive_triangles: usize,
     pub total_power_w: f64,
+    /// Input features that were ignored or approximated (e.g. glTF extensions not modelled).
+    pub warnings: Vec<String>,
 }
 
 /// Where a ray met the scene.
@@ -409,7 +411,7 @@ impl SceneBuilder {
         Ok(())
     }
 
-    /// Counts input primitives that were not loaded (points, lines).
+    /// Counts input primitives that were not loaded (points, lines, no positions).
     pub fn count_skipped_primitives(&mut self, n: usize) {
         self.stats.non_triangle_primitives_skipped += n;
     }
