@@ -9,7 +9,7 @@ use crate::{
     BuildError, FLAG_HALF_SPACE, FLAG_LEAF, FLAG_TWO_SIDED, LightBounds, LightTree, MAX_DEPTH,
     Node, NodeExtra,
 };
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 use std::f32::consts::{FRAC_PI_2, PI};
 
@@ -25,8 +25,8 @@ const AREA_PAD: f32 = 1e-3;
 
 #[derive(Clone, Copy, Debug)]
 struct Prim {
-    min: Vec3,
-    max: Vec3,
+    min: Vec3A,
+    max: Vec3A,
     cone: Cone,
     power: f32,
     light: u32,
@@ -35,7 +35,7 @@ struct Prim {
 
 impl Prim {
     #[inline]
-    fn centroid(&self) -> Vec3 {
+    fn centroid(&self) -> Vec3A {
         (self.min + self.max) * 0.5
     }
 }
@@ -43,10 +43,10 @@ impl Prim {
 /// Aggregate bounds of a set of lights.
 #[derive(Clone, Copy, Debug)]
 struct Agg {
-    min: Vec3,
-    max: Vec3,
-    cmin: Vec3,
-    cmax: Vec3,
+    min: Vec3A,
+    max: Vec3A,
+    cmin: Vec3A,
+    cmax: Vec3A,
     cone: Cone,
     power: f64,
     power_sq: f64,
@@ -56,10 +56,10 @@ struct Agg {
 
 impl Agg {
     const EMPTY: Agg = Agg {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-        cmin: Vec3::INFINITY,
-        cmax: Vec3::NEG_INFINITY,
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
+        cmin: Vec3A::INFINITY,
+        cmax: Vec3A::NEG_INFINITY,
         cone: Cone::EMPTY,
         power: 0.0,
         power_sq: 0.0,
@@ -109,7 +109,7 @@ impl Agg {
     /// SAOH cost term Φ · M_A · M_Ω (surface area with padded extents).
     #[inline]
     fn cost(&self, pad: f32) -> f64 {
-        let e = (self.max - self.min).max(Vec3::splat(pad)).as_dvec3();
+        let e = (self.max - self.min).max(Vec3A::splat(pad)).as_dvec3();
         let area = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
         self.power * area * self.cone.measure() as f64
     }
@@ -146,8 +146,8 @@ fn validate(i: usize, l: &LightBounds) -> Result<Prim, BuildError> {
         return Err(BuildError::ZeroAxis { light: i });
     };
     Ok(Prim {
-        min: l.aabb_min,
-        max: l.aabb_max,
+        min: l.aabb_min.into(),
+        max: l.aabb_max.into(),
         cone: Cone {
             axis,
             theta_o: l.theta_o,
@@ -172,8 +172,8 @@ fn make_node(agg: &Agg, depth: u32, child_or_light: u32, leaf: bool) -> (Node, N
     }
     (
         Node {
-            aabb_min: agg.min,
-            aabb_max: agg.max,
+            aabb_min: agg.min.into(),
+            aabb_max: agg.max.into(),
             radius: 0.5 * (agg.max - agg.min).length(),
             axis: cone.axis,
             power: agg.power as f32,
@@ -209,7 +209,7 @@ fn bucket(c: f32, o: f32, scale: f32) -> usize {
 
 type Bins = [[Agg; NUM_BUCKETS]; 3];
 
-fn bin(prims: &[Prim], origin: Vec3, scale: Vec3, active: [bool; 3]) -> Bins {
+fn bin(prims: &[Prim], origin: Vec3A, scale: Vec3A, active: [bool; 3]) -> Bins {
     let mut bins = [[Agg::EMPTY; NUM_BUCKETS]; 3];
     for p in prims {
         let c = p.centroid();
@@ -242,10 +242,10 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
     // Children sit at depth + 1 and need ceil_log2(k) more levels for k lights.
     let budget = max_depth - (depth + 1);
     if active.iter().any(|&a| a) && n > 2 {
-        let scale = Vec3::select(
-            cext.cmpgt(Vec3::ZERO),
-            Vec3::splat(NUM_BUCKETS as f32) / cext,
-            Vec3::ZERO,
+        let scale = Vec3A::select(
+            cext.cmpgt(Vec3A::ZERO),
+            Vec3A::splat(NUM_BUCKETS as f32) / cext,
+            Vec3A::ZERO,
         );
         let bins = if n >= PAR_BIN {
             prims
@@ -271,10 +271,14 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
             }
             let mut left = Agg::EMPTY;
             for i in 0..NUM_BUCKETS - 1 {
+                // An empty bucket repeats the previous candidate's partition.
+                if b[i].count == 0 {
+                    continue;
+                }
                 left.merge(&b[i]);
                 let r = &right[i + 1];
-                if left.count == 0 || r.count == 0 {
-                    continue;
+                if r.count == 0 {
+                    break;
                 }
                 let cost = kr * (left.cost(pad) + r.cost(pad));
                 if cost.is_finite() && best.as_ref().is_none_or(|bst| cost < bst.0) {
@@ -295,7 +299,7 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
     median_split(prims, cext)
 }
 
-fn median_split(prims: &mut [Prim], cext: Vec3) -> (usize, Agg, Agg) {
+fn median_split(prims: &mut [Prim], cext: Vec3A) -> (usize, Agg, Agg) {
     let mid = prims.len() / 2;
     if cext.max_element() > 0.0 {
         let a = cext.max_position();
