@@ -62,7 +62,13 @@ fn lights(n: usize) -> Vec<LightBounds> {
 fn queries() -> Vec<(Vec3, Vec3, f32)> {
     let mut rng = Pcg32::seed_from_u64(99);
     (0..QUERIES)
-        .map(|_| (rand_point(&mut rng), rand_dir(&mut rng), rng.random::<f32>()))
+        .map(|_| {
+            (
+                rand_point(&mut rng),
+                rand_dir(&mut rng),
+                rng.random::<f32>(),
+            )
+        })
         .collect()
 }
 

@@ -40,7 +40,11 @@ impl Cone {
         if b.is_empty() {
             return a;
         }
-        let (a, b) = if a.theta_o >= b.theta_o { (a, b) } else { (b, a) };
+        let (a, b) = if a.theta_o >= b.theta_o {
+            (a, b)
+        } else {
+            (b, a)
+        };
         let theta_e = a.theta_e.max(b.theta_e);
         if a.theta_o >= PI {
             return Cone {
