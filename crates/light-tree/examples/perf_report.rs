@@ -57,9 +57,9 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(5);
     println!(
-        "| lights | build wall | build CPU | max depth | sample+pmf wall / CPU ns | adaptive cut (τ 0.85, ≤ 64) wall / CPU ns | mean cut size |"
+        "| lights | build wall | build CPU | max depth | sample+pmf wall / CPU ns | adaptive cut (τ 0.85, ≤ 64) wall / CPU ns | mean cut size | sample() = None |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for n in [1_000usize, 10_000, 100_000, 1_000_000] {
         let ls = lights(n);
         let (mut walls, mut cpus) = (Vec::new(), Vec::new());
@@ -82,12 +82,15 @@ fn main() {
         let (mut sp, mut spc) = (Vec::new(), Vec::new());
         let (mut cutt, mut cutc) = (Vec::new(), Vec::new());
         let mut cut_sizes = 0usize;
+        let mut misses = 0usize;
         for _ in 0..reps {
             let (t0, c0) = (Instant::now(), cpu_seconds());
             let mut acc = 0.0f32;
             for &(x, nrm, u) in &qs {
                 if let Some((l, p)) = tree.sample(x, nrm, u) {
                     acc += p + tree.pmf(x, nrm, l);
+                } else {
+                    misses += 1;
                 }
             }
             black_box(acc);
@@ -102,7 +105,7 @@ fn main() {
             cutc.push((cpu_seconds() - c0) * 1e9 / 50_000.0);
         }
         println!(
-            "| {n} | {:.1} ms | {:.2} s | {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.1} |",
+            "| {n} | {:.1} ms | {:.2} s | {} | {:.0} / {:.0} | {:.0} / {:.0} | {:.1} | {:.1} % |",
             median(walls) * 1e3,
             median(cpus),
             tree.max_depth(),
@@ -110,7 +113,8 @@ fn main() {
             median(spc),
             median(cutt),
             median(cutc),
-            cut_sizes as f64 / 50_000.0
+            cut_sizes as f64 / 50_000.0,
+            100.0 * misses as f64 / (reps * qs.len()) as f64
         );
     }
 }
