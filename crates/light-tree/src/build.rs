@@ -14,6 +14,8 @@ use rayon::prelude::*;
 use std::f32::consts::{FRAC_PI_2, PI};
 
 const NUM_BUCKETS: usize = 12;
+/// Nodes with at most this many lights evaluate every sorted split instead of binning.
+const SMALL: usize = NUM_BUCKETS;
 /// Subtrees at least this large are built with `rayon::join`.
 const PAR_SUBTREE: usize = 2048;
 /// Nodes at least this large bin their lights in parallel chunks.
@@ -247,15 +249,23 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
             Vec3A::splat(NUM_BUCKETS as f32) / cext,
             Vec3A::ZERO,
         );
+        let pad = AREA_PAD * longest;
+        if n <= SMALL {
+            return split_small(prims, cext, longest, ext, pad, budget);
+        }
         let bins = if n >= PAR_BIN {
-            prims
+            // Collected in chunk order and folded sequentially: the cone union is not
+            // associative, and a fixed order keeps the build deterministic.
+            let parts: Vec<Bins> = prims
                 .par_chunks(BIN_CHUNK)
                 .map(|ch| bin(ch, agg.cmin, scale, active))
-                .reduce(|| [[Agg::EMPTY; NUM_BUCKETS]; 3], merge_bins)
+                .collect();
+            parts
+                .into_iter()
+                .fold([[Agg::EMPTY; NUM_BUCKETS]; 3], merge_bins)
         } else {
             bin(prims, agg.cmin, scale, active)
         };
-        let pad = AREA_PAD * longest;
         let mut best: Option<(f64, usize, usize, Agg, Agg)> = None;
         for a in 0..3 {
             if !active[a] {
@@ -299,11 +309,65 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
     median_split(prims, cext)
 }
 
+/// Orders lights by centroid along `axis`, ties by light index (deterministic).
+#[inline]
+fn by_axis(axis: usize) -> impl Fn(&Prim, &Prim) -> std::cmp::Ordering {
+    move |p, q| {
+        p.centroid()[axis]
+            .total_cmp(&q.centroid()[axis])
+            .then(p.light.cmp(&q.light))
+    }
+}
+
+/// SAOH for nodes of at most `SMALL` lights: every split of the centroid-sorted order is a
+/// candidate on each axis. That is a superset of the 12 bucket boundaries, and it avoids
+/// setting up 36 buckets for a handful of lights (the bulk of all nodes).
+fn split_small(
+    prims: &mut [Prim],
+    cext: Vec3A,
+    longest: f32,
+    ext: Vec3A,
+    pad: f32,
+    budget: u32,
+) -> (usize, Agg, Agg) {
+    let n = prims.len();
+    let active = [cext.x > 0.0, cext.y > 0.0, cext.z > 0.0];
+    let mut suffix = [Agg::EMPTY; SMALL];
+    let mut best: Option<(f64, usize, usize)> = None;
+    for a in 0..3 {
+        if !active[a] {
+            continue;
+        }
+        prims.sort_unstable_by(by_axis(a));
+        let kr = (longest / ext[a]) as f64;
+        let mut acc = Agg::EMPTY;
+        for i in (1..n).rev() {
+            acc.add(&prims[i]);
+            suffix[i] = acc;
+        }
+        let mut left = Agg::EMPTY;
+        for i in 0..n - 1 {
+            left.add(&prims[i]);
+            let cost = kr * (left.cost(pad) + suffix[i + 1].cost(pad));
+            if cost.is_finite() && best.is_none_or(|b| cost < b.0) {
+                best = Some((cost, a, i + 1));
+            }
+        }
+    }
+    match best {
+        Some((cost, a, mid)) if cost > 0.0 && ceil_log2(mid.max(n - mid)) <= budget => {
+            prims.sort_unstable_by(by_axis(a));
+            let (l, r) = prims.split_at(mid);
+            (mid, Agg::of(l), Agg::of(r))
+        }
+        _ => median_split(prims, cext),
+    }
+}
+
 fn median_split(prims: &mut [Prim], cext: Vec3A) -> (usize, Agg, Agg) {
     let mid = prims.len() / 2;
     if cext.max_element() > 0.0 {
-        let a = cext.max_position();
-        prims.select_nth_unstable_by(mid, |p, q| p.centroid()[a].total_cmp(&q.centroid()[a]));
+        prims.select_nth_unstable_by(mid, by_axis(cext.max_position()));
     }
     let (l, r) = prims.split_at(mid);
     (mid, Agg::of(l), Agg::of(r))
@@ -393,13 +457,11 @@ impl LightTree {
             .collect::<Result<_, _>>()?;
         let num_nodes = 2 * n - 1;
         let root_agg = if n >= PAR_BIN {
-            prims.par_chunks(BIN_CHUNK).map(Agg::of).reduce(
-                || Agg::EMPTY,
-                |mut a, b| {
-                    a.merge(&b);
-                    a
-                },
-            )
+            let parts: Vec<Agg> = prims.par_chunks(BIN_CHUNK).map(Agg::of).collect();
+            parts.iter().fold(Agg::EMPTY, |mut a, b| {
+                a.merge(b);
+                a
+            })
         } else {
             Agg::of(&prims)
         };

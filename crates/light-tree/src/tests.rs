@@ -683,3 +683,15 @@ fn all_dark_receiver() {
     let sum: f32 = (0..30).map(|l| tree.pmf(-x * 5.0, Vec3::ZERO, l)).sum();
     assert!((sum - 1.0).abs() < 1e-5);
 }
+
+/// Two builds of the same input give identical trees, also through the parallel binning
+/// (≥ 65,536 lights) and parallel subtree paths.
+#[test]
+fn build_is_deterministic() {
+    let mut rng = Pcg32::seed_from_u64(10);
+    let lights = rand_lights(&mut rng, 70_000, Layout::Uniform, true);
+    let a = LightTree::build(&lights).unwrap();
+    let b = LightTree::build(&lights).unwrap();
+    assert_eq!(a.nodes(), b.nodes());
+    assert!((0..lights.len()).all(|l| a.bit_trail(l) == b.bit_trail(l)));
+}
