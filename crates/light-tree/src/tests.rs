@@ -695,3 +695,65 @@ fn build_is_deterministic() {
     assert_eq!(a.nodes(), b.nodes());
     assert!((0..lights.len()).all(|l| a.bit_trail(l) == b.bit_trail(l)));
 }
+
+/// Unshadowed irradiance from zero-size emitters spread over a large box, estimated with one
+/// light sample. The exact variance Σ f²/p − F² of the tree's estimator must be far below that
+/// of power-proportional sampling, and every light with f > 0 must have p > 0 (unbiased).
+#[test]
+fn tree_beats_power_sampling_on_spread_lights() {
+    let mut rng = Pcg32::seed_from_u64(11);
+    let lights: Vec<LightBounds> = (0..1000)
+        .map(|i| {
+            let p = rand_in_box(&mut rng, 50.0);
+            let mut l = LightBounds::point(p, 0.1 + rng.random::<f32>());
+            if i % 2 == 0 {
+                l.axis = rand_dir(&mut rng);
+                l.theta_o = 0.0;
+            }
+            l
+        })
+        .collect();
+    let tree = LightTree::build(&lights).unwrap();
+    let total_power: f64 = lights.iter().map(|l| l.power as f64).sum();
+    let (mut var_tree, mut var_power) = (0.0f64, 0.0f64);
+    for _ in 0..50 {
+        let x = rand_in_box(&mut rng, 50.0);
+        let n = rand_dir(&mut rng);
+        let f: Vec<f64> = lights
+            .iter()
+            .map(|l| {
+                let d = l.aabb_min - x;
+                let d2 = d.length_squared() as f64;
+                let w = d.normalize();
+                let emit = if l.theta_o == 0.0 {
+                    (-l.axis.dot(w)).max(0.0)
+                } else {
+                    1.0
+                };
+                l.power as f64 * emit as f64 * n.dot(w).max(0.0) as f64 / d2
+            })
+            .collect();
+        let big_f: f64 = f.iter().sum();
+        if big_f == 0.0 {
+            continue;
+        }
+        let (mut m2_tree, mut m2_power) = (0.0, 0.0);
+        for (l, &fl) in f.iter().enumerate() {
+            if fl == 0.0 {
+                continue;
+            }
+            let p = tree.pmf(x, n, l) as f64;
+            assert!(p > 0.0, "light {l} contributes but has pmf 0");
+            m2_tree += fl * fl / p;
+            m2_power += fl * fl / (lights[l].power as f64 / total_power);
+        }
+        // Relative variances, so every receiver weighs the same.
+        var_tree += (m2_tree - big_f * big_f) / (big_f * big_f);
+        var_power += (m2_power - big_f * big_f) / (big_f * big_f);
+    }
+    eprintln!("relative variance: tree {var_tree:.3}, power {var_power:.3}");
+    assert!(
+        var_tree * 5.0 < var_power,
+        "tree {var_tree} power {var_power}"
+    );
+}
