@@ -333,32 +333,42 @@ fn split_small(
     let n = prims.len();
     let active = [cext.x > 0.0, cext.y > 0.0, cext.z > 0.0];
     let mut suffix = [Agg::EMPTY; SMALL];
-    let mut best: Option<(f64, usize, usize)> = None;
+    // Sort small index arrays rather than the 64-byte lights themselves.
+    let mut order = [[0u8; SMALL]; 3];
+    let mut best: Option<(f64, usize, usize, Agg, Agg)> = None;
     for a in 0..3 {
         if !active[a] {
             continue;
         }
-        prims.sort_unstable_by(by_axis(a));
+        let idx = &mut order[a][..n];
+        for (k, v) in idx.iter_mut().enumerate() {
+            *v = k as u8;
+        }
+        let cmp = by_axis(a);
+        idx.sort_unstable_by(|&i, &j| cmp(&prims[i as usize], &prims[j as usize]));
         let kr = (longest / ext[a]) as f64;
         let mut acc = Agg::EMPTY;
         for i in (1..n).rev() {
-            acc.add(&prims[i]);
+            acc.add(&prims[idx[i] as usize]);
             suffix[i] = acc;
         }
         let mut left = Agg::EMPTY;
         for i in 0..n - 1 {
-            left.add(&prims[i]);
+            left.add(&prims[idx[i] as usize]);
             let cost = kr * (left.cost(pad) + suffix[i + 1].cost(pad));
-            if cost.is_finite() && best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, a, i + 1));
+            if cost.is_finite() && best.as_ref().is_none_or(|b| cost < b.0) {
+                best = Some((cost, a, i + 1, left, suffix[i + 1]));
             }
         }
     }
     match best {
-        Some((cost, a, mid)) if cost > 0.0 && ceil_log2(mid.max(n - mid)) <= budget => {
-            prims.sort_unstable_by(by_axis(a));
-            let (l, r) = prims.split_at(mid);
-            (mid, Agg::of(l), Agg::of(r))
+        Some((cost, a, mid, l, r)) if cost > 0.0 && ceil_log2(mid.max(n - mid)) <= budget => {
+            let mut tmp = [prims[0]; SMALL];
+            tmp[..n].copy_from_slice(prims);
+            for (dst, &src) in prims.iter_mut().zip(&order[a][..n]) {
+                *dst = tmp[src as usize];
+            }
+            (mid, l, r)
         }
         _ => median_split(prims, cext),
     }
