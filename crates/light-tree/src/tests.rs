@@ -136,6 +136,12 @@ fn tree_configs() -> Vec<(usize, Layout, bool)> {
 }
 
 #[test]
+fn node_is_one_cache_line() {
+    assert_eq!(std::mem::size_of::<crate::Node>(), 64);
+    assert_eq!(std::mem::align_of::<crate::Node>(), 64);
+}
+
+#[test]
 fn structure_invariants() {
     let mut rng = Pcg32::seed_from_u64(1);
     for (n, layout, z) in tree_configs() {
