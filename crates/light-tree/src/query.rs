@@ -236,7 +236,11 @@ impl LightTree {
     ///   (one-sided receiver: pass `n` flipped to the side of interest). `n == Vec3::ZERO`
     ///   drops the receiver term (volumes, transmissive BSDFs).
     /// * inside the bounding sphere (d² ≤ r²) both cosines are 1; the squared distance is
-    ///   always max(d², r²/4, 1e-12), the same clamp everywhere.
+    ///   always max(d², r²/4, 1e-12), the same clamp everywhere;
+    /// * in addition (Cycles-style, conservative, also inside the sphere) the importance is 0
+    ///   when the node's box lies wholly behind the receiver's tangent plane, or when the node
+    ///   is one-sided with θo + θe ≤ π/2 and `x` lies behind the box along the axis;
+    /// * for θe > π/2 an emitter cosine ≤ 0 inside the emission range is floored at 1e-3.
     #[inline]
     pub fn importance(&self, node: NodeId, x: Vec3, n: Vec3) -> f32 {
         self.nodes[node as usize].importance(x, n)
