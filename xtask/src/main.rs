@@ -3,7 +3,32 @@ fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
-            println!("cargo xtask <command>\n\ncommands:\n  help    this text");
+            println!(
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report"
+            );
+        }
+        Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
+            // brdf-integrals: fits its tables / writes results/brdf-integrals (see its README)
+            let sub = if cmd == "validate-brdf-integrals" {
+                "validate"
+            } else {
+                cmd
+            };
+            let status = std::process::Command::new(env!("CARGO"))
+                .args([
+                    "run",
+                    "--release",
+                    "-p",
+                    "brdf-integrals",
+                    "--bin",
+                    "brdf-tool",
+                    "--",
+                    sub,
+                ])
+                .args(&args[1..])
+                .status()
+                .expect("failed to run cargo");
+            std::process::exit(status.code().unwrap_or(1));
         }
         Some(other) => {
             eprintln!("error: unknown xtask command `{other}` (try `cargo xtask help`)");
