@@ -1,7 +1,7 @@
 //! The BRDF-oriented light cut (method.md §1.3): from the root, split a node when x lies inside
 //! its bounding sphere or when the glossy lobe's integral over the node's cap exceeds δ. Every
 //! cut node keeps its BO importance and its cap integral (the allocation's UB reuses them).
-use super::importance::{BoRecord, NodeTerms};
+use super::importance::{BoRecord, LobeDensity, NodeTerms};
 use brdf_integrals::LobeIntegral;
 use light_tree::{Cut, LightTree, NodeId};
 use std::collections::VecDeque;
@@ -16,7 +16,7 @@ pub struct BoCut {
 }
 
 impl BoCut {
-    pub fn build<L: LobeIntegral>(
+    pub fn build<L: LobeIntegral + LobeDensity>(
         tree: &LightTree,
         rec: &BoRecord<L>,
         delta: f32,

@@ -35,6 +35,9 @@ pub struct BoRecord<L> {
     pub diffuse_term: bool,
     /// Oat–Sander approximation for |cap ∩ H| (the authors' code) instead of the exact lens.
     pub oat_sander: bool,
+    /// Use the lobe density at the axis for small caps or caps far from the lobe's peak
+    /// (see `point_estimate`); off in `reproduce`.
+    pub point_approx: bool,
 }
 
 /// A node's BO terms at a shading point.
@@ -46,10 +49,40 @@ pub struct NodeTerms {
     pub glossy: f32,
 }
 
-impl<L: LobeIntegral> BoRecord<L> {
+/// The approximate lobe's density g(ω) (∫_cap g ≈ the cap integral) and its peak direction
+/// and angular width, where the approximation has them.
+pub trait LobeDensity {
+    fn density(&self, w: Vec3) -> Option<f32>;
+    fn peak(&self) -> Option<(Vec3, f32)>;
+}
+
+impl LobeDensity for brdf_integrals::SptdLobe {
+    #[inline]
+    fn density(&self, w: Vec3) -> Option<f32> {
+        Some(brdf_integrals::SptdLobe::density(self, w))
+    }
+    /// The SPTD peaks towards r_p/ρ; its angular scale is about 1 − ρ.
+    #[inline]
+    fn peak(&self) -> Option<(Vec3, f32)> {
+        let rho = self.pivot.length();
+        (rho > 1e-3).then(|| (self.pivot / rho, (1.0 - rho).max(1e-4)))
+    }
+}
+
+impl LobeDensity for brdf_integrals::LtcLobe {
+    fn density(&self, _: Vec3) -> Option<f32> {
+        None
+    }
+    fn peak(&self) -> Option<(Vec3, f32)> {
+        None
+    }
+}
+
+impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
     pub fn new(sp: &ShadingPoint, lobe: L, diffuse_term: bool, oat_sander: bool) -> Self {
         let p = &sp.bsdf.params;
         BoRecord {
+            point_approx: !oat_sander,
             x: sp.point(),
             frame: sp.bsdf.frame,
             lobe,
@@ -97,7 +130,10 @@ impl<L: LobeIntegral> BoRecord<L> {
             return NodeTerms::default();
         }
         let glossy = if self.ks > 0.0 {
-            self.lobe.integral(axis, cos).max(0.0)
+            match self.point_estimate(axis, sin2) {
+                Some(g) => g * omega,
+                None => self.lobe.integral(axis, cos).max(0.0),
+            }
         } else {
             0.0
         };
@@ -109,6 +145,32 @@ impl<L: LobeIntegral> BoRecord<L> {
         NodeTerms {
             importance: emit * (self.ks * glossy + diffuse) / omega,
             glossy,
+        }
+    }
+}
+
+impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
+    /// The lobe density at the cap's axis, used instead of the closed-form cap integral
+    /// (as density × |cap|) for caps wholly above the horizon that are either much narrower
+    /// than the lobe or well away from its peak, with half-angle below 0.25 rad. I_BO only
+    /// has to be a deterministic function of (node, shading point) for BO to stay exact in
+    /// its pdf, and this spares most of the f64 cap transforms of a descent.
+    #[inline]
+    fn point_estimate(&self, axis: Vec3, sin2: f32) -> Option<f32> {
+        if !self.point_approx || sin2 > 0.0606 || axis.z * axis.z <= sin2 || axis.z <= 0.0 {
+            return None;
+        }
+        let (peak, width) = self.lobe.peak()?;
+        let narrow = sin2 < (0.25 * width) * (0.25 * width);
+        // angle(axis, peak) > σ + 3·width  ⇔  cos(angle) < cos(σ + 3·width)
+        let far = {
+            let reach = sin2.sqrt().asin() + 3.0 * width;
+            reach < std::f32::consts::PI && axis.dot(peak) < reach.cos()
+        };
+        if narrow || far {
+            self.lobe.density(axis)
+        } else {
+            None
         }
     }
 }

@@ -3,7 +3,7 @@
 use super::allocation::{
     InSampleCounters, SLOT_HITS, SLOT_MISSES, fixed_counts, probability_bo, total_brdf_aware,
 };
-use super::importance::BoRecord;
+use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
 use super::technique::BoState;
 use super::{BoConfig, LobePivot};
@@ -52,7 +52,7 @@ struct Taken {
 
 impl<C: CapIntegral> Mis3<C>
 where
-    C::Lobe: LobePivot,
+    C::Lobe: LobePivot + LobeDensity,
 {
     fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<C::Lobe>> {
         let tree = self.ls.tree.as_ref()?;
@@ -76,7 +76,7 @@ where
 
 impl<C: CapIntegral> DirectLighting for Mis3<C>
 where
-    C::Lobe: LobePivot,
+    C::Lobe: LobePivot + LobeDensity,
 {
     fn name(&self) -> String {
         self.name.clone()

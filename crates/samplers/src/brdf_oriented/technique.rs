@@ -1,7 +1,7 @@
 //! BRDF-oriented light sampling (BO) at one shading point: pick a cluster of the BO cut by
 //! I_BO, descend inside it by I_BO, sample a point on the light; and the pdf of any light point.
 use super::cut::BoCut;
-use super::importance::BoRecord;
+use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
 use brdf_integrals::LobeIntegral;
 use light_tree::{Fresh, LightTree, NodeId, Rescaled};
@@ -10,7 +10,7 @@ use render_core::light::{Light, LightSample};
 use render_core::rng::SampleStream;
 use std::cell::RefCell;
 
-const MEMO_SIZE: usize = 256;
+const MEMO_SIZE: usize = 4096;
 
 /// Direct-mapped cache of node importances of one shading point. Importance is a pure function
 /// of (node, shading point), so a cached value is bit-identical to a recomputed one and the
@@ -36,7 +36,7 @@ pub struct BoState<L> {
     pub pivot: Option<PivotSphere>,
 }
 
-impl<L: LobeIntegral> BoState<L> {
+impl<L: LobeIntegral + LobeDensity> BoState<L> {
     pub fn new(
         tree: &LightTree,
         rec: BoRecord<L>,
@@ -55,7 +55,7 @@ impl<L: LobeIntegral> BoState<L> {
 
     /// I_BO of `id` (memoised).
     pub fn importance(&self, tree: &LightTree, id: NodeId) -> f32 {
-        let slot = (id.wrapping_mul(0x9E37_79B1) >> 24) as usize % MEMO_SIZE;
+        let slot = (id.wrapping_mul(0x9E37_79B1) >> 20) as usize % MEMO_SIZE;
         {
             let m = self.memo.borrow();
             if m.slots[slot].0 == id {
