@@ -349,3 +349,41 @@ fn reproduce_allocation_is_measurably_biased_or_not() {
     );
     assert!(a > 0.0 && (a - b).abs() < 0.2 * a, "{a} vs {b}");
 }
+
+/// Measures the bias of `--reproduce` (the authors' in-sample allocation): whole-image mean of
+/// unlit pixels, default vs reproduce vs a `tree-split+bsdf` reference, with standard errors.
+/// Run: `cargo test -p samplers --test method measure_reproduce_bias -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn measure_reproduce_bias() {
+    let scenes = [
+        ("mixed(40)", common::mixed_scene(40), None),
+        (
+            "glossy-spheres lights=256 r=0.1 rough=0.5",
+            render_core::load_scene(
+                "builtin:glossy-spheres?lights=256&radius=0.1&roughness=0.5",
+                None,
+            )
+            .unwrap(),
+            Some((32, 24)),
+        ),
+    ];
+    for (label, scene, size) in scenes {
+        let w = size.map_or(48, |s: (u32, u32)| s.0);
+        let h = size.map_or(36, |s: (u32, u32)| s.1);
+        let d = StrategyOptions::default();
+        let rep = StrategyOptions {
+            reproduce: true,
+            ..Default::default()
+        };
+        for (name, opts, spp, tag) in [
+            ("tree-split+bsdf", &d, 2048, "reference"),
+            ("mis3-adaptive", &d, 512, "default"),
+            ("mis3-adaptive", &rep, 512, "reproduce"),
+        ] {
+            let r = render_opts(&scene, name, opts, spp, 21, size);
+            let (m, se) = samplers::convergence::region_mean(&r, 0, 0, w, h, true);
+            eprintln!("{label}: {tag:>9} {name} {spp} spp: {m:.6} ± {se:.6}");
+        }
+    }
+}

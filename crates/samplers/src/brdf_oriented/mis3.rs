@@ -140,16 +140,29 @@ where
 
         // Densities of the three techniques at a light point (solid angle; delta lights use
         // the discrete selection probabilities and no BRDF density).
-        let densities = |light: usize, point: Vec3, normal: Vec3, wi: Vec3, delta: bool| {
-            let l = &scene.lights[light];
-            let p_pt = if delta { 1.0 } else { l.pdf(x, point, normal) };
-            let p_ls = self.ls.pmf(&ls_state, sp, light as u32) * p_pt;
-            let p_bo = bo.as_ref().map_or(0.0, |b| {
-                b.selection_pmf(tree, light) * b.point_pdf(l, point, normal, wi)
-            });
-            let p_bsdf = if delta { 0.0 } else { sp.bsdf.pdf(sp.wo, wi) };
-            [p_ls, p_bo, p_bsdf]
-        };
+        // `own` is the sampling technique, whose density the caller already has.
+        let densities =
+            |light: usize, point: Vec3, normal: Vec3, wi: Vec3, delta: bool, own: usize| {
+                let l = &scene.lights[light];
+                let p_ls = if own == TECHNIQUE_LS {
+                    0.0
+                } else {
+                    let p_pt = if delta { 1.0 } else { l.pdf(x, point, normal) };
+                    self.ls.pmf(&ls_state, sp, light as u32) * p_pt
+                };
+                let p_bo = match &bo {
+                    Some(b) if own != TECHNIQUE_BO || cfg!(debug_assertions) => {
+                        b.selection_pmf(tree, light) * b.point_pdf(l, point, normal, wi)
+                    }
+                    _ => 0.0,
+                };
+                let p_bsdf = if delta || own == TECHNIQUE_BSDF {
+                    0.0
+                } else {
+                    sp.bsdf.pdf(sp.wo, wi)
+                };
+                [p_ls, p_bo, p_bsdf]
+            };
         let mut taken: Vec<Taken> = Vec::new();
 
         // LS: one light per cluster of the E&K cut (a splitting technique counts as one sample).
@@ -168,7 +181,14 @@ where
             if f == Vec3::ZERO {
                 continue;
             }
-            let mut p = densities(light as usize, s.point, s.normal, s.wi, s.is_delta);
+            let mut p = densities(
+                light as usize,
+                s.point,
+                s.normal,
+                s.wi,
+                s.is_delta,
+                TECHNIQUE_LS,
+            );
             p[TECHNIQUE_LS] = pmf * s.pdf;
             taken.push(Taken {
                 tech: TECHNIQUE_LS,
@@ -196,7 +216,7 @@ where
                 if f == Vec3::ZERO {
                     return;
                 }
-                let mut p = densities(light, s.point, s.normal, s.wi, s.is_delta);
+                let mut p = densities(light, s.point, s.normal, s.wi, s.is_delta, TECHNIQUE_BO);
                 debug_assert!(
                     (p[TECHNIQUE_BO] - p_bo).abs() <= 1e-3 * p_bo,
                     "BO pdf at sampling {p_bo} vs replay {}",
@@ -219,7 +239,14 @@ where
                 if !b.found_light() {
                     return false;
                 }
-                let mut p = densities(b.light as usize, b.point, b.normal, b.wi, false);
+                let mut p = densities(
+                    b.light as usize,
+                    b.point,
+                    b.normal,
+                    b.wi,
+                    false,
+                    TECHNIQUE_BSDF,
+                );
                 p[TECHNIQUE_BSDF] = b.pdf;
                 taken.push(Taken {
                     tech: TECHNIQUE_BSDF,
