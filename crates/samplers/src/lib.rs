@@ -270,14 +270,24 @@ fn mis3(
                 config,
             })
         }
-        // `Ltc` is a placeholder unit struct until brdf-integrals lands its LTC fit.
-        #[allow(clippy::default_constructed_unit_structs)]
-        BrdfIntegral::Ltc => Box::new(Mis3 {
-            name: name.into(),
-            mode,
-            ls,
-            integral: brdf_integrals::Ltc::default(),
-            config,
-        }),
+        BrdfIntegral::Ltc => {
+            use brdf_integrals::CapIntegral;
+            // `Ltc` is a placeholder (all integrals 0) until brdf-integrals lands its LTC fit.
+            #[allow(clippy::default_constructed_unit_structs)]
+            let integral = brdf_integrals::Ltc::default();
+            let probe = integral.hemisphere(render_core::Vec3::new(0.6, 0.0, 0.8), 0.1);
+            if !(probe > 0.0) {
+                return Err(StrategyError::BadOption(
+                    "--brdf-integral ltc: the LTC fit is not available in this build yet".into(),
+                ));
+            }
+            Box::new(Mis3 {
+                name: name.into(),
+                mode,
+                ls,
+                integral,
+                config,
+            })
+        }
     })
 }
