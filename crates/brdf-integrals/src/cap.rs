@@ -105,26 +105,32 @@ pub(crate) fn below_horizon(c: &Cap64) -> bool {
 }
 
 /// Exact area of the intersection of two caps.
+///
+/// The disjoint / nested / complementary tests compare cosines (no inverse trigonometry); only
+/// a partial overlap pays for the three `acos` of the lens formula.
 #[inline]
 pub(crate) fn lens_area_exact(a: &Cap64, b: &Cap64) -> f64 {
     let cd = a.axis.dot(b.axis).clamp(-1.0, 1.0);
-    let sd = a.axis.cross(b.axis).length().min(1.0);
-    let d = sd.atan2(cd);
-    let (ra, rb) = (a.angle(), b.angle());
-    // disjoint
-    if d >= ra + rb {
-        return 0.0;
+    // cos and sin of ra + rb, cos of |ra − rb|
+    let c_sum = a.cos * b.cos - a.sin * b.sin;
+    let s_sum = a.sin * b.cos + a.cos * b.sin;
+    let c_diff = a.cos * b.cos + a.sin * b.sin;
+    if cd <= c_sum {
+        // d ≥ ra + rb (disjoint) when ra + rb < π; otherwise d ≥ 2π − ra − rb: the complements
+        // are disjoint and the union is the whole sphere
+        return if s_sum >= 0.0 {
+            0.0
+        } else {
+            (a.area() + b.area() - 4.0 * PI).max(0.0)
+        };
     }
-    // one inside the other
-    if d <= (ra - rb).abs() {
-        return if ra <= rb { a.area() } else { b.area() };
+    let sd = a.axis.cross(b.axis).length();
+    if cd >= c_diff - 1e-15 || sd <= 1e-300 {
+        // d ≤ |ra − rb|: one cap inside the other
+        return a.area().min(b.area());
     }
-    // complements disjoint: the union is the whole sphere
-    if d + ra + rb >= 2.0 * PI {
-        return a.area() + b.area() - 4.0 * PI;
-    }
-    // Partial overlap: 0 < d, 0 < ra, rb < π. Area = 2[π − γ − cos ra · α − cos rb · β] with the
-    // angle γ at the intersection points and the half-angles α, β at the two axes.
+    // Partial overlap: 0 < d < π and 0 < ra, rb < π. Area = 2[π − γ − cos ra · α − cos rb · β]
+    // with the angle γ at the intersection points and the half-angles α, β at the two axes.
     let x = ((cd - a.cos * b.cos) / (a.sin * b.sin)).clamp(-1.0, 1.0);
     let ya = ((b.cos - cd * a.cos) / (sd * a.sin)).clamp(-1.0, 1.0);
     let yb = ((a.cos - cd * b.cos) / (sd * b.sin)).clamp(-1.0, 1.0);
@@ -132,22 +138,25 @@ pub(crate) fn lens_area_exact(a: &Cap64, b: &Cap64) -> f64 {
     area.clamp(0.0, a.area().min(b.area()))
 }
 
-/// Oat–Sander approximation of the intersection area.
+/// Oat–Sander approximation of the intersection area (exact nested / disjoint cases by cosine
+/// tests; the angles are only computed in the smoothstep band).
 #[inline]
 pub(crate) fn lens_area_oat_sander(a: &Cap64, b: &Cap64) -> f64 {
     let cd = a.axis.dot(b.axis).clamp(-1.0, 1.0);
-    let d = cd.acos();
-    let (ra, rb) = (a.angle(), b.angle());
-    let rmin = ra.min(rb);
-    let rmax = ra.max(rb);
-    let small = if ra <= rb { a.area() } else { b.area() };
-    if d <= rmax - rmin {
+    let c_sum = a.cos * b.cos - a.sin * b.sin;
+    let s_sum = a.sin * b.cos + a.cos * b.sin;
+    let c_diff = a.cos * b.cos + a.sin * b.sin;
+    let small = a.area().min(b.area());
+    if cd >= c_diff {
         return small;
     }
-    if d >= ra + rb {
+    if cd <= c_sum && s_sum >= 0.0 {
         return 0.0;
     }
-    let t = ((d - (rmax - rmin)) / (ra + rb - (rmax - rmin))).clamp(0.0, 1.0);
+    let d = cd.acos();
+    let (ra, rb) = (a.angle(), b.angle());
+    let rdiff = (ra - rb).abs();
+    let t = ((d - rdiff) / (ra + rb - rdiff)).clamp(0.0, 1.0);
     let x = 1.0 - t;
     x * x * (3.0 - 2.0 * x) * small
 }

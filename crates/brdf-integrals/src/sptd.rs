@@ -158,6 +158,12 @@ impl SptdLobe {
             intersection,
         }
     }
+    /// A sampler of directions in `cap` distributed ∝ this SPTD restricted to the cap (for sampling
+    /// a sphere light by the lobe, method.md §3.1). Its samples may fall below the horizon, where
+    /// the lobe is zero.
+    pub fn cap_sampler(&self, cap: &Cap) -> crate::pivot::CapSampler {
+        crate::pivot::CapSampler::new(self.pivot, cap)
+    }
     /// T(H), the pivot-transformed upper hemisphere.
     pub fn transformed_hemisphere(&self) -> Cap {
         self.th.to32()

@@ -42,6 +42,12 @@ pub struct RenderArgs {
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
     #[arg(long)]
     pub aux: bool,
+    /// Adaptive tree splitting threshold τ (tree-split and mis3 strategies).
+    #[arg(long, default_value_t = StrategyOptions::default().tau)]
+    pub tau: f32,
+    /// Most clusters in an adaptive light cut (tree-split strategies; mis3: both cuts).
+    #[arg(long, default_value_t = StrategyOptions::default().max_cut)]
+    pub max_cut: usize,
     /// Print ray throughput.
     #[arg(long)]
     pub stats: bool,
@@ -54,12 +60,6 @@ pub struct RenderArgs {
 /// Knobs of the light-tree and Liu et al. 2019 strategies (defaults: the authors' values).
 #[derive(Args, Debug, Clone)]
 pub struct MethodArgs {
-    /// Adaptive tree splitting threshold τ (E&K normalised variance; tree-split*, mis3-*).
-    #[arg(long, default_value_t = 0.85)]
-    pub tau: f32,
-    /// Most clusters in a light cut (E&K cut and BRDF-oriented cut).
-    #[arg(long, default_value_t = 64)]
-    pub max_cut: usize,
     /// BRDF-oriented cut: split a node whose cap integral of the glossy lobe exceeds δ.
     #[arg(long, default_value_t = 0.5)]
     pub delta: f32,
@@ -94,10 +94,10 @@ pub enum BrdfIntegralArg {
 }
 
 impl MethodArgs {
-    pub fn options(&self) -> StrategyOptions {
+    pub fn options(&self, tau: f32, max_cut: usize) -> StrategyOptions {
         StrategyOptions {
-            tau: self.tau,
-            max_cut: self.max_cut,
+            tau,
+            max_cut,
             delta: self.delta,
             n_max: self.n_max,
             lambda: self.lambda,
@@ -180,7 +180,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         check_writable(p)?;
     }
     let scene = render_core::load_scene(&args.scene, args.camera.as_deref())?;
-    let opts = args.method.options();
+    let opts = args.method.options(args.tau, args.max_cut);
     let strategy = samplers::create(&args.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");

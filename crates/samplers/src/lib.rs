@@ -4,7 +4,7 @@
 //! Every technique can both sample a light point and evaluate the density of any light point,
 //! so strategies combine them by multiple importance sampling.
 
-// `!(x > 0.0)` is the intended NaN-rejecting test throughout.
+// `!(x > 0.0)` is deliberate: it is also true for NaN, which must be rejected too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod alias;
@@ -272,13 +272,15 @@ fn mis3(
         }
         BrdfIntegral::Ltc => {
             use brdf_integrals::CapIntegral;
-            // `Ltc` is a placeholder (all integrals 0) until brdf-integrals lands its LTC fit.
-            #[allow(clippy::default_constructed_unit_structs)]
-            let integral = brdf_integrals::Ltc::default();
+            let mut integral = brdf_integrals::Ltc::default();
+            if opts.reproduce {
+                integral.lookup = Lookup::Nearest;
+            }
+            // Sanity check of the table (a placeholder build would integrate to 0).
             let probe = integral.hemisphere(render_core::Vec3::new(0.6, 0.0, 0.8), 0.1);
             if !(probe > 0.0) {
                 return Err(StrategyError::BadOption(
-                    "--brdf-integral ltc: the LTC fit is not available in this build yet".into(),
+                    "--brdf-integral ltc: the LTC table integrates to 0".into(),
                 ));
             }
             Box::new(Mis3 {

@@ -67,7 +67,12 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         adaptive_split: false,
         ..d.clone()
     };
+    let ltc = StrategyOptions {
+        brdf_integral: samplers::brdf_oriented::BrdfIntegral::Ltc,
+        ..d.clone()
+    };
     for (name, opts, label) in [
+        ("mis3-adaptive", &ltc, "mis3-adaptive --brdf-integral ltc"),
         ("mis3-equal", &d, "mis3-equal"),
         ("mis3-adaptive", &d, "mis3-adaptive"),
         ("mis3-adaptive", &pivot, "mis3-adaptive --pivot-sphere"),

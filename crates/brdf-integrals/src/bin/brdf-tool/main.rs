@@ -106,9 +106,10 @@ fn main() {
                 .unwrap_or(crate_dir.join("../../results/brdf-integrals"));
             validate::run(samples, &out);
         }
+        Some("bench-cpu") => bench_cpu(),
         _ => {
             eprintln!(
-                "usage: brdf-tool fit-sptd|fit-ltc|validate [--samples N] [--albedo-samples N] [--out DIR]"
+                "usage: brdf-tool fit-sptd|fit-ltc|validate|bench-cpu [--samples N] [--albedo-samples N] [--out DIR]"
             );
             std::process::exit(2);
         }
@@ -126,4 +127,68 @@ fn summary(xs: impl Iterator<Item = f64>) -> String {
         v[n - 1],
         v.iter().sum::<f64>() / n as f64
     )
+}
+
+/// CPU seconds (user + system) of the calling thread, from /proc (clock ticks of 10 ms), so the
+/// cost per evaluation can be measured on a machine shared with other jobs.
+fn thread_cpu_seconds() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
+    let rest = &s[s.rfind(')')? + 2..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks: f64 = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
+/// `bench-cpu`: CPU time per cap integral (single thread, ~3 CPU-seconds per method).
+fn bench_cpu() {
+    use brdf_integrals::{CapIntegral, Intersection, LobeIntegral, Ltc, Sptd, ggx};
+    use glam::Vec3;
+    let mut caps = Vec::new();
+    let mut rng = brdf_integrals::qmc::SplitMix64::new(5);
+    for _ in 0..1024 {
+        let z = rng.next_f64() * 1.3 - 0.3;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = rng.next_f64() * std::f64::consts::TAU;
+        let ang = (0.005f64.ln() + rng.next_f64() * (1.0f64.ln() - 0.005f64.ln())).exp();
+        caps.push((
+            Vec3::new((r * phi.cos()) as f32, (r * phi.sin()) as f32, z as f32),
+            ang.cos() as f32,
+        ));
+    }
+    let wo = ggx::wo_from_theta(0.8);
+    let run = |name: &str, f: &dyn Fn(Vec3, f32) -> f32| {
+        let mut n = 0usize;
+        let mut acc = 0.0f32;
+        let t0 = thread_cpu_seconds().unwrap_or(0.0);
+        let w0 = Instant::now();
+        while thread_cpu_seconds().unwrap_or(0.0) - t0 < 3.0 && w0.elapsed().as_secs_f64() < 30.0 {
+            for _ in 0..200 {
+                for &(a, c) in &caps {
+                    acc += f(std::hint::black_box(a), std::hint::black_box(c));
+                }
+            }
+            n += 200 * caps.len();
+        }
+        let cpu = thread_cpu_seconds().unwrap_or(0.0) - t0;
+        println!(
+            "{name:<28} {:7.1} ns CPU / evaluation ({n} evaluations, {cpu:.2} CPU-s, {:.2} s wall, checksum {acc:.3})",
+            cpu * 1e9 / n as f64,
+            w0.elapsed().as_secs_f64()
+        );
+    };
+    let sptd = Sptd::default();
+    let lobe = sptd.lobe(wo, 0.1);
+    run("sptd integral (exact)", &|a, c| lobe.integral(a, c));
+    let so = Sptd::default().intersection(Intersection::OatSander);
+    let lobe = so.lobe(wo, 0.1);
+    run("sptd integral (oat-sander)", &|a, c| lobe.integral(a, c));
+    let ltc = Ltc::default();
+    let lobe = ltc.lobe(wo, 0.1);
+    run("ltc integral", &|a, c| lobe.integral(a, c));
+    run("sptd lobe()", &|a, c| {
+        sptd.lobe(wo, 0.1 + 1e-9 * c).hemisphere() + a.x
+    });
+    run("ltc lobe()", &|a, c| {
+        ltc.lobe(wo, 0.1 + 1e-9 * c).hemisphere() + a.x
+    });
 }
