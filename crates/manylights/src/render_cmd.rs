@@ -42,17 +42,101 @@ pub struct RenderArgs {
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
     #[arg(long)]
     pub aux: bool,
-    /// Adaptive tree splitting threshold τ (tree-split strategies).
+    /// Adaptive tree splitting threshold τ (tree-split and mis3 strategies).
     #[arg(long, default_value_t = StrategyOptions::default().tau)]
     pub tau: f32,
-    /// Most clusters in an adaptive light cut (tree-split strategies).
+    /// Most clusters in an adaptive light cut (tree-split strategies; mis3: both cuts).
     #[arg(long, default_value_t = StrategyOptions::default().max_cut)]
     pub max_cut: usize,
     /// Print ray throughput.
     #[arg(long)]
     pub stats: bool,
+    #[command(flatten)]
+    pub method: MethodArgs,
     #[arg(long)]
     pub quiet: bool,
+}
+
+/// Knobs of the light-tree and Liu et al. 2019 strategies (defaults: the authors' values).
+#[derive(Args, Debug, Clone)]
+pub struct MethodArgs {
+    /// BRDF-oriented cut: split a node whose cap integral of the glossy lobe exceeds δ.
+    #[arg(long, default_value_t = 0.5)]
+    pub delta: f32,
+    /// Most BRDF-aware samples beyond the forced two (N = floor(N_max·UB)).
+    #[arg(long, default_value_t = 50)]
+    pub n_max: u32,
+    /// Weight of a BRDF-sampling hit in P(BO) = n_nohit / (n_nohit + λ·n_hit).
+    #[arg(long, default_value_t = 10.0)]
+    pub lambda: f32,
+    /// Cap-integral approximation behind BRDF-oriented sampling.
+    #[arg(long, value_enum, default_value = "sptd")]
+    pub brdf_integral: BrdfIntegralArg,
+    /// The authors' code's behaviour: nearest SPTD lookup, Oat–Sander cap ∩ cap, glossy-only
+    /// importance, one rescaled random number per descent, in-sample (biased) allocation.
+    #[arg(long)]
+    pub reproduce: bool,
+    /// Sample points on sphere lights by the pivot-transformed lobe (mixed with cone sampling).
+    #[arg(long)]
+    pub pivot_sphere: bool,
+    /// Turn off heuristic 1 (N = floor(N_max·UB)); N = N_max/2 instead.
+    #[arg(long)]
+    pub no_adaptive_total: bool,
+    /// Turn off heuristic 2 (P(BO) from hits and misses); P(BO) = 1/2 instead.
+    #[arg(long)]
+    pub no_adaptive_split: bool,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum BrdfIntegralArg {
+    Sptd,
+    Ltc,
+}
+
+impl MethodArgs {
+    pub fn options(&self, tau: f32, max_cut: usize) -> StrategyOptions {
+        StrategyOptions {
+            tau,
+            max_cut,
+            delta: self.delta,
+            n_max: self.n_max,
+            lambda: self.lambda,
+            brdf_integral: match self.brdf_integral {
+                BrdfIntegralArg::Sptd => samplers::brdf_oriented::BrdfIntegral::Sptd,
+                BrdfIntegralArg::Ltc => samplers::brdf_oriented::BrdfIntegral::Ltc,
+            },
+            reproduce: self.reproduce,
+            pivot_sphere: self.pivot_sphere,
+            adaptive_total: !self.no_adaptive_total,
+            adaptive_split: !self.no_adaptive_split,
+        }
+    }
+}
+
+/// False-colour PNGs of the allocation diagnostics, as the talk shows them: the BRDF-aware
+/// count N (black → blue → green → yellow → white over 0..N_max) and the BO vs BRDF-sampling
+/// share (blue = BO, red = BRDF sampling).
+fn false_colour(name: &str, v: f32, n_max: u32) -> Option<glam::Vec3> {
+    use glam::Vec3;
+    match name {
+        "n_brdf_aware" => {
+            let stops = [
+                Vec3::ZERO,
+                Vec3::new(0.0, 0.1, 1.0),
+                Vec3::new(0.0, 0.8, 0.1),
+                Vec3::new(1.0, 0.9, 0.0),
+                Vec3::ONE,
+            ];
+            let t = (v / n_max.max(1) as f32).clamp(0.0, 1.0) * (stops.len() - 1) as f32;
+            let i = (t as usize).min(stops.len() - 2);
+            Some(stops[i].lerp(stops[i + 1], t - i as f32))
+        }
+        "bo_share" => {
+            let s = v.clamp(0.0, 1.0);
+            Some(Vec3::new(1.0 - s, 0.0, s))
+        }
+        _ => None,
+    }
 }
 
 fn sibling(out: &Path, suffix: &str) -> PathBuf {
@@ -96,10 +180,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         check_writable(p)?;
     }
     let scene = render_core::load_scene(&args.scene, args.camera.as_deref())?;
-    let opts = StrategyOptions {
-        tau: args.tau,
-        max_cut: args.max_cut,
-    };
+    let opts = args.method.options(args.tau, args.max_cut);
     let strategy = samplers::create(&args.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
@@ -159,6 +240,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             let px: Vec<glam::Vec3> = values.iter().map(|&v| glam::Vec3::splat(v)).collect();
             write_exr(&exr, width, height, &px).map_err(anyhow::Error::msg)?;
             aux_files.push(exr);
+            let colours: Option<Vec<glam::Vec3>> = values
+                .iter()
+                .map(|&v| false_colour(name, v, opts.n_max))
+                .collect();
+            if let Some(colours) = colours {
+                let png = sibling(&args.out, &format!(".{name}.png"));
+                write_png(&png, width, height, &colours, 0.0).map_err(anyhow::Error::msg)?;
+                aux_files.push(png);
+            }
         }
     }
     let techniques = strategy.techniques();

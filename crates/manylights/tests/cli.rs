@@ -228,6 +228,70 @@ fn compare_reports_error_against_a_reference() {
 }
 
 #[test]
+fn mis3_flags_and_false_colour_aux() {
+    let dir = temp_dir("mis3");
+    for (name, extra) in [
+        (
+            "adaptive",
+            vec![
+                "--delta", "0.4", "--n-max", "20", "--lambda", "5", "--tau", "0.8",
+            ],
+        ),
+        (
+            "repro",
+            vec!["--reproduce", "--pivot-sphere", "--max-cut", "16"],
+        ),
+        ("noh", vec!["--no-adaptive-total", "--no-adaptive-split"]),
+    ] {
+        let out = dir.join(format!("{name}.exr"));
+        let mut args = vec![
+            "render",
+            SCENE,
+            "--strategy",
+            "mis3-adaptive",
+            "--spp",
+            "2",
+            "--width",
+            "16",
+            "--height",
+            "12",
+            "--quiet",
+            "--aux",
+            "--out",
+            out.to_str().unwrap(),
+        ];
+        args.extend(extra);
+        let o = manylights(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        for suffix in ["n_brdf_aware.png", "bo_share.png", "n_brdf_aware.exr"] {
+            assert!(
+                dir.join(format!("{name}.{suffix}")).is_file(),
+                "{name}.{suffix}"
+            );
+        }
+        let meta: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap(),
+        )
+        .unwrap();
+        assert!(meta["technique_samples"]["bo"].as_u64().unwrap() > 0);
+    }
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("adaptive.json")).unwrap()).unwrap();
+    assert_eq!(meta["strategy_parameters"]["n_max"], 20);
+    let o = manylights(&[
+        "render",
+        SCENE,
+        "--strategy",
+        "mis3-adaptive",
+        "--delta",
+        "-1",
+        "--out",
+        dir.join("bad.exr").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+}
+
+#[test]
 fn cap_integral_batch_agrees_across_methods() {
     use std::io::Write;
     let run = |method: &str, input: &str| {

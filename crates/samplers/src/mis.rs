@@ -53,4 +53,32 @@ mod tests {
         assert_eq!(power2(0.0, 1.0), 0.0);
         assert_eq!(power2(1.0, 0.0), 1.0);
     }
+
+    #[test]
+    fn weights_with_counts_sum_to_one_over_random_pdf_sets() {
+        use rand::{RngExt, SeedableRng};
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(17);
+        for _ in 0..20_000 {
+            let k = rng.random_range(1..5usize);
+            let set: Vec<(f32, f32)> = (0..k)
+                .map(|_| {
+                    let n = rng.random_range(0..60u32) as f32;
+                    let e = rng.random_range(-30.0f32..30.0);
+                    let p = if rng.random::<f32>() < 0.1 {
+                        0.0
+                    } else {
+                        10f32.powf(e)
+                    };
+                    (n, p)
+                })
+                .collect();
+            let any = set.iter().any(|&(n, p)| n * p > 0.0);
+            let sum: f32 = (0..k).map(|t| power_heuristic(t, &set)).sum();
+            if any {
+                assert!((sum - 1.0).abs() < 1e-4, "{set:?}: {sum}");
+            } else {
+                assert_eq!(sum, 0.0);
+            }
+        }
+    }
 }

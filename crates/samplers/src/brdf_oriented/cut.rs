@@ -1,0 +1,112 @@
+//! The BRDF-oriented light cut (method.md §1.3): from the root, split a node when x lies inside
+//! its bounding sphere or when the glossy lobe's integral over the node's cap exceeds δ. Every
+//! cut node keeps its BO importance and its cap integral (the allocation's UB reuses them).
+use super::importance::{BoRecord, LobeDensity, NodeTerms};
+use brdf_integrals::LobeIntegral;
+use light_tree::{Cut, LightTree, NodeId};
+use std::collections::VecDeque;
+
+/// A BO cut: node ids sorted by DFS id with their terms and the cumulative importance.
+#[derive(Clone, Debug, Default)]
+pub struct BoCut {
+    pub cut: Cut,
+    pub terms: Vec<NodeTerms>,
+    /// cdf[k] = Σ_{j ≤ k} I_BO(cut node j).
+    pub cdf: Vec<f32>,
+}
+
+impl BoCut {
+    pub fn build<L: LobeIntegral + LobeDensity>(
+        tree: &LightTree,
+        rec: &BoRecord<L>,
+        delta: f32,
+        max_size: usize,
+    ) -> BoCut {
+        let mut out: Vec<(NodeId, NodeTerms)> = Vec::new();
+        let mut queue = VecDeque::new();
+        queue.push_back(tree.root());
+        let mut size = 1usize;
+        while let Some(id) = queue.pop_front() {
+            let node = tree.node(id);
+            let can_split = !node.is_leaf() && size < max_size.max(1);
+            // Inside the bounding sphere: split before computing anything (as the authors do).
+            if can_split
+                && node.contains(rec.x)
+                && node.importance(rec.x, render_core::Vec3::ZERO) > 0.0
+            {
+                let r = node.right_child().unwrap();
+                queue.push_back(id + 1);
+                queue.push_back(r);
+                size += 1;
+                continue;
+            }
+            let t = rec.terms(node);
+            if can_split && t.importance > 0.0 && t.glossy > delta {
+                queue.push_back(id + 1);
+                queue.push_back(node.right_child().unwrap());
+                size += 1;
+            } else {
+                out.push((id, t));
+            }
+        }
+        out.sort_unstable_by_key(|&(id, _)| id);
+        let mut cdf = Vec::with_capacity(out.len());
+        let mut acc = 0.0f32;
+        for &(_, t) in &out {
+            acc += t.importance;
+            cdf.push(acc);
+        }
+        BoCut {
+            cut: Cut {
+                nodes: out.iter().map(|&(id, _)| id).collect(),
+            },
+            terms: out.into_iter().map(|(_, t)| t).collect(),
+            cdf,
+        }
+    }
+
+    pub fn total(&self) -> f32 {
+        self.cdf.last().copied().unwrap_or(0.0)
+    }
+
+    /// Probability of picking cluster `k`.
+    pub fn cluster_pmf(&self, k: usize) -> f32 {
+        let total = self.total();
+        if total > 0.0 {
+            self.terms[k].importance / total
+        } else {
+            0.0
+        }
+    }
+
+    /// Picks a cluster for `u` ∈ [0, 1): `(index, pmf, u rescaled into the cluster's interval)`.
+    pub fn pick(&self, u: f32) -> Option<(usize, f32, f32)> {
+        let total = self.total();
+        if !(total > 0.0) {
+            return None;
+        }
+        let target = u * total;
+        let mut k = self.cdf.partition_point(|&c| c <= target);
+        // Skip zero-width intervals (rounding) and stay in range.
+        k = k.min(self.cdf.len() - 1);
+        while self.terms[k].importance <= 0.0 && k > 0 {
+            k -= 1;
+        }
+        let imp = self.terms[k].importance;
+        if !(imp > 0.0) {
+            return None;
+        }
+        let lo = if k > 0 { self.cdf[k - 1] } else { 0.0 };
+        let rest = ((target - lo) / imp).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        Some((k, imp / total, rest))
+    }
+
+    /// UB = clamp(max over the cut of the cached glossy cap integrals, 0, 1) (heuristic 1).
+    pub fn upper_bound(&self) -> f32 {
+        self.terms
+            .iter()
+            .map(|t| t.glossy)
+            .fold(0.0f32, f32::max)
+            .clamp(0.0, 1.0)
+    }
+}

@@ -1,0 +1,277 @@
+//! The per-shading-point BRDF record and the BRDF-oriented node importance I_BO
+//! (Liu, Xu & Yan 2019; method.md §1.2, §1.4).
+//!
+//! For a node with bounding sphere (c, r) seen from x, cap(C) is the cone the sphere subtends,
+//! expressed in the BSDF's local frame (z = shading normal, x = ωo projected). Then
+//!
+//! I_BO(C) = Φ_C · cos̄θ_C / d² · (Ks · ∫_{cap∩H} f_GGX·cos + Kd/π · ∫_{cap∩H} cos) / |cap ∩ H|
+//!
+//! where Φ_C·cos̄θ_C/d² is the light tree's emitter bound (Conty Estevez & Kulla) without the
+//! receiver cosine (the cosine sits inside the integrals). The default adds the diffuse term;
+//! `reproduce` keeps the authors' glossy-only importance and Oat–Sander cap ∩ cap.
+use brdf_integrals::LobeIntegral;
+use brdf_integrals::cap::{Cap, intersection_area_exact, intersection_area_oat_sander};
+use light_tree::Node;
+use render_core::Vec3;
+use render_core::estimator::ShadingPoint;
+use render_core::frame::Frame;
+use std::f32::consts::PI;
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// What the BO importance needs of a shading point; built once per shading point.
+#[derive(Clone, Copy, Debug)]
+pub struct BoRecord<L> {
+    pub x: Vec3,
+    pub frame: Frame,
+    /// The glossy lobe's cap integral (SPTD or LTC), un-Fresnelled, without Ks.
+    pub lobe: L,
+    /// Luminance of the specular and diffuse albedos.
+    pub ks: f32,
+    pub kd: f32,
+    /// Add the diffuse term Kd/π × projected solid angle (our default; off in `reproduce`).
+    pub diffuse_term: bool,
+    /// Oat–Sander approximation for |cap ∩ H| (the authors' code) instead of the exact lens.
+    pub oat_sander: bool,
+    /// Use the lobe density at the axis for small caps or caps far from the lobe's peak
+    /// (see `point_estimate`); off in `reproduce`.
+    pub point_approx: bool,
+}
+
+/// A node's BO terms at a shading point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeTerms {
+    /// I_BO (0 when the node cannot be reached or its cap lies below the horizon).
+    pub importance: f32,
+    /// ∫_{cap∩H} f·cos of the glossy lobe without Ks (the split test and the allocation's UB).
+    pub glossy: f32,
+}
+
+/// The approximate lobe's density g(ω) (∫_cap g ≈ the cap integral) and its peak direction
+/// and angular width, where the approximation has them.
+pub trait LobeDensity {
+    fn density(&self, w: Vec3) -> Option<f32>;
+    fn peak(&self) -> Option<(Vec3, f32)>;
+}
+
+impl LobeDensity for brdf_integrals::SptdLobe {
+    #[inline]
+    fn density(&self, w: Vec3) -> Option<f32> {
+        Some(brdf_integrals::SptdLobe::density(self, w))
+    }
+    /// The SPTD peaks towards r_p/ρ; its angular scale is about 1 − ρ.
+    #[inline]
+    fn peak(&self) -> Option<(Vec3, f32)> {
+        let rho = self.pivot.length();
+        (rho > 1e-3).then(|| (self.pivot / rho, (1.0 - rho).max(1e-4)))
+    }
+}
+
+impl LobeDensity for brdf_integrals::LtcLobe {
+    fn density(&self, _: Vec3) -> Option<f32> {
+        None
+    }
+    fn peak(&self) -> Option<(Vec3, f32)> {
+        None
+    }
+}
+
+impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
+    pub fn new(sp: &ShadingPoint, lobe: L, diffuse_term: bool, oat_sander: bool) -> Self {
+        let p = &sp.bsdf.params;
+        BoRecord {
+            point_approx: !oat_sander,
+            x: sp.point(),
+            frame: sp.bsdf.frame,
+            lobe,
+            ks: if sp.bsdf.is_pure_diffuse() {
+                0.0
+            } else {
+                luminance(p.f0).max(0.0)
+            },
+            kd: luminance(p.diffuse).max(0.0),
+            diffuse_term,
+            oat_sander,
+        }
+    }
+
+    /// BO terms of `node`.
+    pub fn terms(&self, node: &Node) -> NodeTerms {
+        // Φ · cos̄θ_C / max(d², r²/4): the tree's importance without a receiver normal.
+        let emit = node.importance(self.x, Vec3::ZERO);
+        if !(emit > 0.0) {
+            return NodeTerms::default();
+        }
+        let to_c = node.center() - self.x;
+        let d2 = to_c.length_squared();
+        let r = node.radius();
+        let r2 = r * r;
+        if d2 <= r2 {
+            // x inside the bounding sphere: the whole hemisphere is the cap.
+            let glossy = if self.ks > 0.0 {
+                self.lobe.hemisphere().max(0.0)
+            } else {
+                0.0
+            };
+            let diffuse = if self.diffuse_term { self.kd } else { 0.0 };
+            return NodeTerms {
+                importance: emit * (self.ks * glossy + diffuse) / (2.0 * PI),
+                glossy,
+            };
+        }
+        let d = d2.sqrt();
+        let axis = self.frame.to_local(to_c / d).normalize();
+        let sin2 = (r2 / d2).min(1.0);
+        let cos = (1.0 - sin2).max(0.0).sqrt();
+        let omega = clipped_solid_angle(axis, sin2, cos, self.oat_sander);
+        if !(omega > 0.0) {
+            return NodeTerms::default();
+        }
+        let glossy = if self.ks > 0.0 {
+            match self.point_estimate(axis, sin2) {
+                Some(g) => g * omega,
+                None => self.lobe.integral(axis, cos).max(0.0),
+            }
+        } else {
+            0.0
+        };
+        let diffuse = if self.diffuse_term && self.kd > 0.0 {
+            self.kd / PI * clipped_projected_solid_angle(axis.z, sin2)
+        } else {
+            0.0
+        };
+        NodeTerms {
+            importance: emit * (self.ks * glossy + diffuse) / omega,
+            glossy,
+        }
+    }
+}
+
+impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
+    /// The lobe density at the cap's axis, used instead of the closed-form cap integral
+    /// (as density × |cap|) for caps wholly above the horizon that are either much narrower
+    /// than the lobe or well away from its peak, with half-angle below 0.25 rad. I_BO only
+    /// has to be a deterministic function of (node, shading point) for BO to stay exact in
+    /// its pdf, and this spares most of the f64 cap transforms of a descent.
+    #[inline]
+    fn point_estimate(&self, axis: Vec3, sin2: f32) -> Option<f32> {
+        if !self.point_approx || sin2 > 0.0606 || axis.z * axis.z <= sin2 || axis.z <= 0.0 {
+            return None;
+        }
+        let (peak, width) = self.lobe.peak()?;
+        let narrow = sin2 < (0.25 * width) * (0.25 * width);
+        // angle(axis, peak) > σ + 3·width  ⇔  cos(angle) < cos(σ + 3·width)
+        let far = {
+            let reach = sin2.sqrt().asin() + 3.0 * width;
+            reach < std::f32::consts::PI && axis.dot(peak) < reach.cos()
+        };
+        if narrow || far {
+            self.lobe.density(axis)
+        } else {
+            None
+        }
+    }
+}
+
+/// |cap ∩ H| for the cap of axis `axis` (local, unit) with sin² and cos of its half-angle.
+/// Caps wholly above the horizon use 2π sin²/(1 + cos), free of cancellation for tiny caps.
+pub fn clipped_solid_angle(axis: Vec3, sin2: f32, cos: f32, oat_sander: bool) -> f32 {
+    let sin = sin2.sqrt();
+    // elevation test: the lowest point of the cap has z = axis.z·cos − sin_axis·sin
+    let sin_axis = (1.0 - axis.z * axis.z).max(0.0).sqrt();
+    let lowest = axis.z * cos - sin_axis * sin;
+    let highest = axis.z * cos + sin_axis * sin;
+    if highest <= 0.0 && !(cos <= 0.0) {
+        return 0.0;
+    }
+    if lowest >= 0.0 {
+        return 2.0 * PI * sin2 / (1.0 + cos);
+    }
+    let cap = Cap::new(axis, cos);
+    let h = Cap::upper_hemisphere();
+    if oat_sander {
+        intersection_area_oat_sander(&cap, &h)
+    } else {
+        intersection_area_exact(&cap, &h)
+    }
+}
+
+/// ∫_{cap ∩ H} cos θ dω for a cap whose axis makes cos θ = `cos_t` with the normal and whose
+/// half-angle σ has sin²σ = `sin2` < 1 (the illuminance of a unit-radiance sphere with the
+/// horizon clipped; Snyder 1996 closed form, as in Lagarde & de Rousiers 2014).
+pub fn clipped_projected_solid_angle(cos_t: f32, sin2: f32) -> f32 {
+    if cos_t * cos_t > sin2 {
+        return if cos_t > 0.0 { PI * sin2 * cos_t } else { 0.0 };
+    }
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let x = (1.0 / sin2 - 1.0).max(0.0).sqrt();
+    let y = if sin_t > 0.0 {
+        (-x * cos_t / sin_t).clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    let s = sin_t * (1.0 - y * y).max(0.0).sqrt();
+    let a = if x > 0.0 { (s / x).atan() } else { PI / 2.0 };
+    ((cos_t * y.acos() - x * s) * sin2 + a).max(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{RngExt, SeedableRng};
+
+    /// Monte Carlo ∫_{cap∩H} g over uniform directions in the cap.
+    fn mc(axis: Vec3, cos: f32, g: impl Fn(Vec3) -> f32, n: usize) -> f64 {
+        let f = Frame::from_normal(axis);
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(3);
+        let omc = 1.0 - cos as f64;
+        let mut s = 0.0;
+        for _ in 0..n {
+            let c = 1.0 - rng.random::<f64>() * omc;
+            let phi = 2.0 * std::f64::consts::PI * rng.random::<f64>();
+            let r = (1.0 - c * c).max(0.0).sqrt();
+            let w = f.to_world(Vec3::new(
+                (r * phi.cos()) as f32,
+                (r * phi.sin()) as f32,
+                c as f32,
+            ));
+            if w.z > 0.0 {
+                s += g(w) as f64;
+            }
+        }
+        s / n as f64 * 2.0 * std::f64::consts::PI * omc
+    }
+
+    #[test]
+    fn clipped_integrals_match_monte_carlo() {
+        for (elev, half) in [
+            (1.2f32, 0.3f32),
+            (0.2, 0.5),
+            (-0.1, 0.4),
+            (0.0, 1.2),
+            (0.7, 1.4),
+            (1.55, 0.2),
+        ] {
+            let axis = Vec3::new(elev.cos(), 0.0, elev.sin());
+            let (sin2, cos) = (half.sin().powi(2), half.cos());
+            let ps = clipped_projected_solid_angle(axis.z, sin2) as f64;
+            let ps_mc = mc(axis, cos, |w| w.z, 200_000);
+            assert!(
+                (ps - ps_mc).abs() < 0.01 * ps_mc.max(0.05),
+                "{elev} {half}: {ps} vs {ps_mc}"
+            );
+            let sa = clipped_solid_angle(axis, sin2, cos, false) as f64;
+            let sa_mc = mc(axis, cos, |_| 1.0, 200_000);
+            assert!(
+                (sa - sa_mc).abs() < 0.01 * sa_mc.max(0.05),
+                "{elev} {half}: {sa} vs {sa_mc}"
+            );
+        }
+        // below the horizon
+        let axis = Vec3::new(0.0, 0.6, -0.8);
+        assert_eq!(clipped_projected_solid_angle(axis.z, 0.01), 0.0);
+        assert_eq!(clipped_solid_angle(axis, 0.01, 0.99f32.sqrt(), false), 0.0);
+    }
+}

@@ -1,0 +1,351 @@
+//! The strategies of Liu, Xu & Yan 2019: BO alone, and three-technique MIS (tree-splitting light
+//! sampling LS + BRDF-oriented light sampling BO + BRDF sampling) with equal or adaptive counts.
+use super::allocation::{
+    InSampleCounters, SLOT_HITS, SLOT_MISSES, fixed_counts, probability_bo, total_brdf_aware,
+};
+use super::importance::{BoRecord, LobeDensity};
+use super::pivot_sphere::PivotSphere;
+use super::technique::BoState;
+use super::{BoConfig, LobePivot};
+use crate::bsdf_sampling::sample_bsdf;
+use crate::mis::power_heuristic;
+use crate::selection::LightSelection;
+use crate::tree_selection::TreeSelection;
+use brdf_integrals::CapIntegral;
+use render_core::Vec3;
+use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+
+pub const TECHNIQUE_LS: usize = 0;
+pub const TECHNIQUE_BO: usize = 1;
+pub const TECHNIQUE_BSDF: usize = 2;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mis3Mode {
+    /// BO alone: one BO sample. **Not a complete estimator**: the SPTD/LTC approximation (and,
+    /// in `reproduce`, the glossy-only importance) can give zero importance to a light that
+    /// contributes, so it is biased there; kept out of the unbiasedness tests.
+    BoOnly,
+    /// LS + BO + BRDF with one sample each.
+    Equal,
+    /// The full method: N = floor(N_max·UB) extra BRDF-aware samples split by P(BO).
+    Adaptive,
+}
+
+pub struct Mis3<C: CapIntegral> {
+    pub name: String,
+    pub mode: Mis3Mode,
+    pub ls: TreeSelection,
+    pub integral: C,
+    pub config: BoConfig,
+}
+
+/// A sample with a non-zero unweighted contribution: technique, f·L (shadowed), and the densities
+/// of the three techniques at its light point.
+#[derive(Clone, Copy, Debug)]
+struct Taken {
+    tech: usize,
+    f: Vec3,
+    p: [f32; 3],
+}
+
+impl<C: CapIntegral> Mis3<C>
+where
+    C::Lobe: LobePivot + LobeDensity,
+{
+    fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<C::Lobe>> {
+        let tree = self.ls.tree.as_ref()?;
+        let wo_local = sp.bsdf.frame.to_local(sp.wo);
+        let lobe = self.integral.lobe(wo_local, sp.bsdf.params.alpha);
+        let pivot = if self.config.pivot_sphere {
+            lobe.pivot().map(|pivot| PivotSphere { pivot })
+        } else {
+            None
+        };
+        let rec = BoRecord::new(sp, lobe, !self.config.reproduce, self.config.reproduce);
+        Some(BoState::new(
+            tree,
+            rec,
+            self.config.delta,
+            self.config.max_cut_bo,
+            pivot,
+        ))
+    }
+}
+
+impl<C: CapIntegral> DirectLighting for Mis3<C>
+where
+    C::Lobe: LobePivot + LobeDensity,
+{
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::to_value(&self.config).unwrap_or(serde_json::Value::Null)
+    }
+
+    fn techniques(&self) -> Vec<&'static str> {
+        match self.mode {
+            Mis3Mode::BoOnly => vec!["bo"],
+            _ => vec!["ls", "bo", "bsdf"],
+        }
+    }
+
+    fn aux_channels(&self) -> Vec<&'static str> {
+        match self.mode {
+            Mis3Mode::BoOnly => vec![],
+            _ => vec!["n_brdf_aware", "bo_share"],
+        }
+    }
+
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let Some(tree) = self.ls.tree.as_ref() else {
+            return Vec3::ZERO;
+        };
+        let x = sp.point();
+        let fresh = !self.config.reproduce;
+
+        if self.mode == Mis3Mode::BoOnly {
+            let Some(bo) = self.bo_state(sp) else {
+                return Vec3::ZERO;
+            };
+            ctx.counters.technique_samples[0] += 1;
+            let Some((light, p_sel)) = bo.select(tree, rng, fresh) else {
+                return Vec3::ZERO;
+            };
+            let Some(s) = bo.sample_point(&scene.lights[light], rng) else {
+                return Vec3::ZERO;
+            };
+            let p = p_sel * s.pdf;
+            if !(p > 0.0) {
+                return Vec3::ZERO;
+            }
+            return sp.shade(scene, &s, ctx.counters) / p;
+        }
+
+        let bo = if sp.bsdf.is_pure_diffuse() {
+            None
+        } else {
+            self.bo_state(sp)
+        };
+        let ls_state = self.ls.prepare(scene, sp);
+
+        // Densities of the three techniques at a light point (solid angle; delta lights use
+        // the discrete selection probabilities and no BRDF density).
+        // `own` is the sampling technique, whose density the caller already has.
+        let densities =
+            |light: usize, point: Vec3, normal: Vec3, wi: Vec3, delta: bool, own: usize| {
+                let l = &scene.lights[light];
+                let p_ls = if own == TECHNIQUE_LS {
+                    0.0
+                } else {
+                    let p_pt = if delta { 1.0 } else { l.pdf(x, point, normal) };
+                    self.ls.pmf(&ls_state, sp, light as u32) * p_pt
+                };
+                let p_bo = match &bo {
+                    Some(b) if own != TECHNIQUE_BO || cfg!(debug_assertions) => {
+                        b.selection_pmf(tree, light) * b.point_pdf(l, point, normal, wi)
+                    }
+                    _ => 0.0,
+                };
+                let p_bsdf = if delta || own == TECHNIQUE_BSDF {
+                    0.0
+                } else {
+                    sp.bsdf.pdf(sp.wo, wi)
+                };
+                [p_ls, p_bo, p_bsdf]
+            };
+        let mut taken: Vec<Taken> = Vec::new();
+
+        // LS: one light per cluster of the E&K cut (a splitting technique counts as one sample).
+        let mut picks = Vec::new();
+        self.ls.pick(&ls_state, sp, rng, &mut picks);
+        for &(light, pmf) in &picks {
+            let u = rng.next_2d();
+            ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
+            let Some(s) = scene.lights[light as usize].sample(x, u) else {
+                continue;
+            };
+            if !(pmf * s.pdf > 0.0) {
+                continue;
+            }
+            let f = sp.shade(scene, &s, ctx.counters);
+            if f == Vec3::ZERO {
+                continue;
+            }
+            let mut p = densities(
+                light as usize,
+                s.point,
+                s.normal,
+                s.wi,
+                s.is_delta,
+                TECHNIQUE_LS,
+            );
+            p[TECHNIQUE_LS] = pmf * s.pdf;
+            taken.push(Taken {
+                tech: TECHNIQUE_LS,
+                f,
+                p,
+            });
+        }
+
+        // One BO sample.
+        let bo_sample =
+            |taken: &mut Vec<Taken>, rng: &mut SampleStream, ctx: &mut SampleContext| {
+                let Some(b) = bo.as_ref() else { return };
+                ctx.counters.technique_samples[TECHNIQUE_BO] += 1;
+                let Some((light, p_sel)) = b.select(tree, rng, fresh) else {
+                    return;
+                };
+                let Some(s) = b.sample_point(&scene.lights[light], rng) else {
+                    return;
+                };
+                let p_bo = p_sel * s.pdf;
+                if !(p_bo > 0.0) {
+                    return;
+                }
+                let f = sp.shade(scene, &s, ctx.counters);
+                if f == Vec3::ZERO {
+                    return;
+                }
+                let mut p = densities(light, s.point, s.normal, s.wi, s.is_delta, TECHNIQUE_BO);
+                debug_assert!(
+                    (p[TECHNIQUE_BO] - p_bo).abs() <= 1e-3 * p_bo,
+                    "BO pdf at sampling {p_bo} vs replay {}",
+                    p[TECHNIQUE_BO]
+                );
+                p[TECHNIQUE_BO] = p_bo;
+                taken.push(Taken {
+                    tech: TECHNIQUE_BO,
+                    f,
+                    p,
+                });
+            };
+        // One BRDF sample; returns whether it reached an emitter.
+        let bsdf_sample =
+            |taken: &mut Vec<Taken>, rng: &mut SampleStream, ctx: &mut SampleContext| {
+                ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
+                let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters) else {
+                    return false;
+                };
+                if !b.found_light() {
+                    return false;
+                }
+                let mut p = densities(
+                    b.light as usize,
+                    b.point,
+                    b.normal,
+                    b.wi,
+                    false,
+                    TECHNIQUE_BSDF,
+                );
+                p[TECHNIQUE_BSDF] = b.pdf;
+                taken.push(Taken {
+                    tech: TECHNIQUE_BSDF,
+                    f: b.f_cos * b.radiance,
+                    p,
+                });
+                true
+            };
+
+        let (n_bo, n_brdf, n_extra) = match (&bo, self.mode) {
+            (None, _) => {
+                bsdf_sample(&mut taken, rng, ctx);
+                (0, 1, 0)
+            }
+            (Some(_), Mis3Mode::Equal) => {
+                bo_sample(&mut taken, rng, ctx);
+                bsdf_sample(&mut taken, rng, ctx);
+                (1, 1, 0)
+            }
+            (Some(b), _) => {
+                let n = total_brdf_aware(
+                    b.cut.upper_bound(),
+                    self.config.n_max,
+                    self.config.adaptive_total,
+                );
+                if self.config.reproduce {
+                    // The authors' in-sample loop (biased: the outcomes pick the counts).
+                    let mut c = InSampleCounters::new(self.config.lambda);
+                    bo_sample(&mut taken, rng, ctx);
+                    c.record(bsdf_sample(&mut taken, rng, ctx));
+                    let (mut n_bo, mut n_brdf) = (1, 1);
+                    for _ in 0..n {
+                        let p = if self.config.adaptive_split {
+                            c.p_bo()
+                        } else {
+                            0.5
+                        };
+                        if rng.next_f32() < p {
+                            bo_sample(&mut taken, rng, ctx);
+                            n_bo += 1;
+                        } else {
+                            c.record(bsdf_sample(&mut taken, rng, ctx));
+                            n_brdf += 1;
+                        }
+                    }
+                    (n_bo, n_brdf, n)
+                } else {
+                    // Counts fixed before drawing, from earlier samples of this pixel.
+                    let p = if self.config.adaptive_split {
+                        probability_bo(
+                            ctx.pixel_memory[SLOT_HITS],
+                            ctx.pixel_memory[SLOT_MISSES],
+                            self.config.lambda,
+                        )
+                    } else {
+                        0.5
+                    };
+                    let (n_bo, n_brdf) = fixed_counts(n, p);
+                    for _ in 0..n_bo {
+                        bo_sample(&mut taken, rng, ctx);
+                    }
+                    let mut hits = 0u32;
+                    for _ in 0..n_brdf {
+                        hits += bsdf_sample(&mut taken, rng, ctx) as u32;
+                    }
+                    ctx.pixel_memory[SLOT_HITS] += hits as f32;
+                    ctx.pixel_memory[SLOT_MISSES] += (n_brdf - hits) as f32;
+                    (n_bo, n_brdf, n)
+                }
+            }
+        };
+        ctx.aux[0] = n_extra as f32;
+        ctx.aux[1] = if n_bo + n_brdf > 0 {
+            n_bo as f32 / (n_bo + n_brdf) as f32
+        } else {
+            0.0
+        };
+
+        let counts = [1.0f32, n_bo as f32, n_brdf as f32];
+        let mut l = Vec3::ZERO;
+        for t in &taken {
+            let techniques = [
+                (counts[0], t.p[0]),
+                (counts[1], t.p[1]),
+                (counts[2], t.p[2]),
+            ];
+            let w = power_heuristic(t.tech, &techniques);
+            debug_assert!(
+                {
+                    let sum: f32 = (0..3).map(|k| power_heuristic(k, &techniques)).sum();
+                    (sum - 1.0).abs() < 1e-4
+                },
+                "MIS weights do not sum to one: {techniques:?}"
+            );
+            let np = counts[t.tech] * t.p[t.tech];
+            if np > 0.0 && w > 0.0 {
+                l += t.f * (w / np);
+            }
+        }
+        l
+    }
+}

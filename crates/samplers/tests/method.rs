@@ -1,0 +1,429 @@
+//! Liu, Xu & Yan 2019 (issue 5): convergence of the three-technique strategies, pdf
+//! consistency of every technique, chi-square tests of BO and of pivot cap sampling.
+mod common;
+use brdf_integrals::{CapIntegral, Sptd};
+use render_core::Vec3;
+use render_core::chi2::{chi2_directions, chi2_test};
+use render_core::estimator::{PIXEL_MEMORY, SampleContext, ShadingPoint};
+use render_core::render::{RenderResult, RenderSettings, render, shading_point};
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+use render_core::stats::Counters;
+use samplers::brdf_oriented::importance::BoRecord;
+use samplers::brdf_oriented::pivot_sphere::PivotSphere;
+use samplers::brdf_oriented::technique::BoState;
+use samplers::convergence::compare;
+use samplers::selection::LightSelection;
+use samplers::tree_selection::{TreeMode, TreeSelection};
+use samplers::{StrategyOptions, create};
+
+fn render_opts(
+    scene: &Scene,
+    name: &str,
+    opts: &StrategyOptions,
+    spp: u32,
+    seed: u64,
+    size: Option<(u32, u32)>,
+) -> RenderResult {
+    let strategy = create(name, scene, opts).unwrap();
+    let mut camera = scene.camera(None).unwrap();
+    if let Some((w, h)) = size {
+        camera.width = w;
+        camera.height = h;
+    }
+    let settings = RenderSettings {
+        width: camera.width,
+        height: camera.height,
+        spp: Some(spp),
+        seed,
+        time_budget: None,
+        threads: Some(2),
+        camera,
+    };
+    render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
+}
+
+fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32, spp: u32) {
+    let d = StrategyOptions::default();
+    let reference = render_opts(scene, "power+bsdf", &d, ref_spp, 1, size);
+    let (mean, se) = samplers::convergence::region_mean(
+        &reference,
+        0,
+        0,
+        reference.width,
+        reference.height,
+        true,
+    );
+    assert!(
+        mean > 0.0 && se < 0.05 * mean,
+        "reference lacks power: {mean} ± {se}"
+    );
+    let pivot = StrategyOptions {
+        pivot_sphere: true,
+        ..d.clone()
+    };
+    let no_h = StrategyOptions {
+        adaptive_total: false,
+        adaptive_split: false,
+        ..d.clone()
+    };
+    let ltc = StrategyOptions {
+        brdf_integral: samplers::brdf_oriented::BrdfIntegral::Ltc,
+        ..d.clone()
+    };
+    for (name, opts, label) in [
+        ("mis3-adaptive", &ltc, "mis3-adaptive --brdf-integral ltc"),
+        ("mis3-equal", &d, "mis3-equal"),
+        ("mis3-adaptive", &d, "mis3-adaptive"),
+        ("mis3-adaptive", &pivot, "mis3-adaptive --pivot-sphere"),
+        ("mis3-adaptive", &no_h, "mis3-adaptive without heuristics"),
+    ] {
+        let r = render_opts(scene, name, opts, spp, 2, size);
+        let failures = compare(&reference, &r, 2, 3.0);
+        assert!(
+            failures.is_empty(),
+            "{label} vs power+bsdf on {}:\n{}",
+            scene.name,
+            failures.join("\n")
+        );
+    }
+}
+
+#[test]
+fn mis3_converges_on_the_mixed_scene() {
+    check_against_reference(&common::mixed_scene(40), None, 256, 64);
+}
+
+#[test]
+fn mis3_converges_on_glossy_spheres() {
+    let scene = render_core::load_scene(
+        "builtin:glossy-spheres?lights=64&radius=0.1&roughness=0.5",
+        None,
+    )
+    .unwrap();
+    // Small lights on a sharp glossy ground have heavy-tailed estimates for every strategy
+    // (the sample mean at low spp sits below the converged value), so the test uses lights
+    // and roughness for which 32 spp is already in the asymptotic regime.
+    check_against_reference(&scene, Some((32, 24)), 512, 32);
+}
+
+#[test]
+fn mis3_converges_on_diffuse_quads() {
+    let scene = render_core::load_scene("builtin:diffuse-quads?lights=64", None).unwrap();
+    check_against_reference(&scene, Some((32, 24)), 128, 32);
+}
+
+#[test]
+fn reproduce_mode_and_bo_alone_run() {
+    let scene = common::mixed_scene(20);
+    let opts = StrategyOptions {
+        reproduce: true,
+        ..Default::default()
+    };
+    for name in ["brdf-oriented", "mis3-equal", "mis3-adaptive"] {
+        let r = render_opts(&scene, name, &opts, 2, 3, None);
+        assert!(r.pixels.iter().all(|p| p.is_finite()), "{name}");
+    }
+    let r = render_opts(
+        &scene,
+        "brdf-oriented",
+        &StrategyOptions::default(),
+        2,
+        3,
+        None,
+    );
+    assert!(r.pixels.iter().any(|p| p.x > 0.0));
+}
+
+/// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
+fn shading_points(scene: &Scene) -> Vec<ShadingPoint> {
+    let cam = Vec3::new(0.0, 1.4, 2.6);
+    [
+        Vec3::new(0.1, 0.0, -0.4),
+        Vec3::new(-0.6, 0.45, 0.0),
+        Vec3::new(-1.2, 0.0, 0.5),
+        Vec3::new(0.9, 0.0, -1.2),
+    ]
+    .iter()
+    .filter_map(|&target| {
+        let d = (target - cam).normalize();
+        let hit = scene.intersect(cam, d, 0.0, f32::INFINITY)?;
+        shading_point(scene, hit, -d)
+    })
+    .collect()
+}
+
+fn bo_state(
+    sel: &TreeSelection,
+    sp: &ShadingPoint,
+    pivot: bool,
+) -> BoState<<Sptd as CapIntegral>::Lobe> {
+    let sptd = Sptd::default();
+    let lobe = sptd.lobe(sp.bsdf.frame.to_local(sp.wo), sp.bsdf.params.alpha);
+    let pivot = pivot.then_some(PivotSphere { pivot: lobe.pivot });
+    BoState::new(
+        sel.tree.as_ref().unwrap(),
+        BoRecord::new(sp, lobe, true, false),
+        0.5,
+        64,
+        pivot,
+    )
+}
+
+#[test]
+fn every_technique_pdf_at_sampling_equals_its_replay() {
+    let scene = common::mixed_scene(40);
+    let sel = TreeSelection::new(
+        &scene,
+        TreeMode::Split {
+            tau: 0.85,
+            max_cut: 64,
+        },
+    )
+    .unwrap();
+    let tree = sel.tree.as_ref().unwrap();
+    let sps = shading_points(&scene);
+    assert!(sps.len() >= 3);
+    let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * a.abs().max(b.abs());
+    for sp in &sps {
+        let x = sp.point();
+        for pivot in [false, true] {
+            let bo = bo_state(&sel, sp, pivot);
+            assert!(!bo.cut.cut.is_empty());
+            let mut checked = 0;
+            for i in 0..2000 {
+                let mut rng = SampleStream::new(5, 0, i);
+                let Some((light, p_sel)) = bo.select(tree, &mut rng, true) else {
+                    continue;
+                };
+                assert!(
+                    close(p_sel, bo.selection_pmf(tree, light)),
+                    "BO selection pmf"
+                );
+                let l = &scene.lights[light];
+                if let Some(s) = bo.sample_point(l, &mut rng) {
+                    let replay = bo.point_pdf(l, s.point, s.normal, s.wi);
+                    assert!(close(s.pdf, replay), "BO point pdf {} vs {replay}", s.pdf);
+                    checked += 1;
+                }
+            }
+            assert!(checked > 500);
+        }
+        // LS: the splitting selection's pick probability equals its pmf; light pdfs replay.
+        let state = sel.prepare(&scene, sp);
+        for i in 0..200 {
+            let mut rng = SampleStream::new(6, 0, i);
+            let mut picks = Vec::new();
+            sel.pick(&state, sp, &mut rng, &mut picks);
+            for (light, pmf) in picks {
+                assert!(close(pmf, sel.pmf(&state, sp, light)));
+                let l = &scene.lights[light as usize];
+                if let Some(s) = l.sample(x, rng.next_2d()) {
+                    assert!(close(s.pdf, l.pdf(x, s.point, s.normal)));
+                }
+            }
+        }
+        // BRDF sampling.
+        for i in 0..500 {
+            let mut rng = SampleStream::new(7, 0, i);
+            if let Some(s) = sp.bsdf.sample(sp.wo, rng.next_f32(), rng.next_2d()) {
+                assert!(close(s.pdf, sp.bsdf.pdf(sp.wo, s.wi)));
+            }
+        }
+    }
+}
+
+#[test]
+fn bo_selection_matches_its_pmf_chi2() {
+    let scene = common::mixed_scene(40);
+    let sel = TreeSelection::new(
+        &scene,
+        TreeMode::Split {
+            tau: 0.85,
+            max_cut: 64,
+        },
+    )
+    .unwrap();
+    let tree = sel.tree.as_ref().unwrap();
+    for (k, sp) in shading_points(&scene).iter().enumerate() {
+        for fresh in [true, false] {
+            let bo = bo_state(&sel, sp, false);
+            let n = scene.lights.len();
+            let mut observed = vec![0.0; n + 1];
+            let samples = 100_000;
+            for i in 0..samples {
+                let mut rng = SampleStream::new(11 + k as u64, 0, i);
+                match bo.select(tree, &mut rng, fresh) {
+                    Some((light, _)) => observed[light] += 1.0,
+                    None => observed[n] += 1.0,
+                }
+            }
+            let mut expected: Vec<f64> = (0..n)
+                .map(|l| bo.selection_pmf(tree, l) as f64 * samples as f64)
+                .collect();
+            let total: f64 = expected.iter().sum();
+            expected.push((samples as f64 - total).max(0.0));
+            let out = chi2_test(&observed, &expected);
+            assert!(
+                out.p_value > 1e-4,
+                "point {k} fresh {fresh}: p = {} ({})",
+                out.p_value,
+                out.message
+            );
+        }
+    }
+}
+
+#[test]
+fn pivot_sphere_sampling_matches_its_pdf_chi2() {
+    let scene = common::mixed_scene(40);
+    let sel = TreeSelection::new(
+        &scene,
+        TreeMode::Split {
+            tau: 0.85,
+            max_cut: 64,
+        },
+    )
+    .unwrap();
+    let sp = shading_points(&scene)[0];
+    // A large sphere light close to the point, so the cap spans many histogram bins.
+    let mut b = render_core::scene::SceneBuilder::new("one sphere");
+    b.add_sphere_light(sp.point() + Vec3::new(0.2, 0.5, 0.1), 0.3, Vec3::ONE, None)
+        .unwrap();
+    let one = b.build().unwrap();
+    let light = &one.lights[0];
+    let bo = bo_state(&sel, &sp, true);
+    let pivot = bo.pivot.unwrap();
+    let mut i = 0u64;
+    let out = chi2_directions(
+        200_000,
+        32,
+        64,
+        16,
+        |_| {
+            i += 1;
+            let mut rng = SampleStream::new(13, 0, i);
+            pivot.sample(&bo.rec, light, &mut rng).map(|s| s.wi)
+        },
+        |w| {
+            // The density of the direction: the cap is the sphere's visible side.
+            let c = sp.point() + Vec3::new(0.2, 0.5, 0.1);
+            let to_c = c - sp.point();
+            let b = w.dot(to_c);
+            let disc = 0.09 - (to_c.length_squared() - b * b);
+            if disc < 0.0 || b <= 0.0 {
+                return 0.0;
+            }
+            let p = sp.point() + w * (b - disc.sqrt());
+            pivot.pdf(&bo.rec, light, p, (p - c).normalize(), w) as f64
+        },
+    );
+    assert!(out.p_value > 1e-4, "p = {} ({})", out.p_value, out.message);
+}
+
+#[test]
+fn reproduce_and_default_allocations_agree_at_a_glossy_point() {
+    // Not an assertion of bias: a smoke test that both allocations estimate the same value
+    // at one glossy point to within a loose tolerance (the bias is measured in the report).
+    let scene = common::mixed_scene(40);
+    let sp = shading_points(&scene)[0];
+    let est = |opts: &StrategyOptions, seed: u64| {
+        let s = create("mis3-adaptive", &scene, opts).unwrap();
+        let mut counters = Counters::default();
+        let mut memory = [0.0; PIXEL_MEMORY];
+        let n = 4000;
+        let mut sum = 0.0f64;
+        for i in 0..n {
+            let mut rng = SampleStream::new(seed, 0, i);
+            let mut ctx = SampleContext {
+                counters: &mut counters,
+                aux: [0.0; 4],
+                pixel_memory: &mut memory,
+            };
+            sum += s.estimate(&scene, &sp, &mut rng, &mut ctx).x as f64;
+        }
+        sum / n as f64
+    };
+    let a = est(&StrategyOptions::default(), 1);
+    let b = est(
+        &StrategyOptions {
+            reproduce: true,
+            ..Default::default()
+        },
+        2,
+    );
+    assert!(a > 0.0 && (a - b).abs() < 0.2 * a, "{a} vs {b}");
+}
+
+/// Measures the bias of `--reproduce` (the authors' in-sample allocation): whole-image mean of
+/// unlit pixels, default vs reproduce vs a `tree-split+bsdf` reference, with standard errors.
+/// Run: `cargo test -p samplers --test method measure_reproduce_bias -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn measure_reproduce_bias() {
+    let scenes = [
+        ("mixed(40)", common::mixed_scene(40), None),
+        (
+            "glossy-spheres lights=256 r=0.1 rough=0.5",
+            render_core::load_scene(
+                "builtin:glossy-spheres?lights=256&radius=0.1&roughness=0.5",
+                None,
+            )
+            .unwrap(),
+            Some((32, 24)),
+        ),
+    ];
+    for (label, scene, size) in scenes {
+        let w = size.map_or(48, |s: (u32, u32)| s.0);
+        let h = size.map_or(36, |s: (u32, u32)| s.1);
+        let d = StrategyOptions::default();
+        let rep = StrategyOptions {
+            reproduce: true,
+            ..Default::default()
+        };
+        for (name, opts, spp, tag) in [
+            ("tree-split+bsdf", &d, 2048, "reference"),
+            ("mis3-adaptive", &d, 512, "default"),
+            ("mis3-adaptive", &rep, 512, "reproduce"),
+        ] {
+            let r = render_opts(&scene, name, opts, spp, 21, size);
+            let (m, se) = samplers::convergence::region_mean(&r, 0, 0, w, h, true);
+            eprintln!("{label}: {tag:>9} {name} {spp} spp: {m:.6} ± {se:.6}");
+        }
+    }
+}
+
+/// Writes a mask (non-black = left out) keeping the pixels whose camera ray at the pixel centre
+/// hits a surface with GGX α < `MAX_ALPHA` (default 0.05), e.g. the bunny and armadillo of the
+/// authors' Cornell box. Env: `SCENE`, `WIDTH`, `HEIGHT`, `GLOSSY_MASK_PNG`.
+#[test]
+#[ignore]
+fn make_glossy_mask() {
+    let spec = std::env::var("SCENE").expect("SCENE");
+    let w: u32 = std::env::var("WIDTH").unwrap().parse().unwrap();
+    let h: u32 = std::env::var("HEIGHT").unwrap().parse().unwrap();
+    let max_alpha: f32 = std::env::var("MAX_ALPHA").map_or(0.05, |s| s.parse().unwrap());
+    let dst = std::env::var("GLOSSY_MASK_PNG").expect("GLOSSY_MASK_PNG");
+    let scene = render_core::load_scene(&spec, None).unwrap();
+    let camera = scene.camera(None).unwrap();
+    let aspect = w as f32 / h as f32;
+    let mut excluded = vec![1.0f32; (w * h) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let film =
+                render_core::Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let dir = camera.ray_direction(film, aspect);
+            if let Some(hit) = scene.intersect(camera.position, dir, 0.0, f32::INFINITY)
+                && let Some(m) = hit.material
+                && scene.materials[m as usize].params_at(hit.uv).alpha < max_alpha
+            {
+                excluded[(y * w + x) as usize] = 0.0;
+            }
+        }
+    }
+    render_core::output::write_mask_png(std::path::Path::new(&dst), w, h, &excluded).unwrap();
+    eprintln!(
+        "glossy pixels: {}",
+        excluded.iter().filter(|&&e| e == 0.0).count()
+    );
+}
