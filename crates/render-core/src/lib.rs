@@ -5,6 +5,9 @@
 //! Light-sampling strategies live in the `samplers` crate and plug in through
 //! [`estimator::DirectLighting`].
 
+// `!(x > 0.0)` is deliberate: it is also true for NaN, which must be rejected too.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod accel;
 pub mod bsdf;
 pub mod builtin;

@@ -215,8 +215,8 @@ pub fn render(
                             px.sum_sq[k] += v * v;
                         }
                         px.light_hits += sees_light as u32;
-                        for k in 0..n_aux {
-                            px.aux[k] += aux[k] as f64;
+                        for (acc, v) in px.aux.iter_mut().zip(aux).take(n_aux) {
+                            *acc += v as f64;
                         }
                     }
                     c

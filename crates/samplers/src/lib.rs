@@ -4,6 +4,9 @@
 //! Every technique can both sample a light point and evaluate the density of any light point,
 //! so strategies combine them by multiple importance sampling.
 
+// `!(x > 0.0)` is deliberate: it is also true for NaN, which must be rejected too.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 pub mod alias;
 pub mod bsdf_sampling;
 pub mod convergence;
