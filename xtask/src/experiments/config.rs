@@ -151,7 +151,9 @@ pub fn params_to_args(
 
 impl SceneEntry {
     pub fn label(&self) -> String {
-        self.label.clone().unwrap_or_else(|| label_from_spec(&self.spec))
+        self.label
+            .clone()
+            .unwrap_or_else(|| label_from_spec(&self.spec))
     }
     pub fn is_builtin(&self) -> bool {
         self.spec.starts_with("builtin:")
@@ -177,8 +179,8 @@ pub fn label_from_spec(spec: &str) -> String {
 
 /// Loads and validates `path`; the experiment's name is the file stem.
 pub fn load(path: &Path) -> Result<Experiment, String> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| format!("cannot read {}: {e}", path.display()))?;
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
@@ -206,7 +208,11 @@ fn validate(e: &Experiment) -> Result<(), String> {
     if e.spp.contains(&0) {
         return Err("every entry of `spp` must be at least 1".into());
     }
-    if let Some(t) = e.time_budgets.iter().find(|t| !(t.is_finite() && **t > 0.0)) {
+    if let Some(t) = e
+        .time_budgets
+        .iter()
+        .find(|t| !(t.is_finite() && **t > 0.0))
+    {
         return Err(format!(
             "time budget {t} is not a positive number of seconds"
         ));
@@ -220,7 +226,9 @@ fn validate(e: &Experiment) -> Result<(), String> {
     if e.strategies.is_empty() {
         return Err("no [[strategies]]".into());
     }
-    e.reference.cli_args().map_err(|m| format!("reference: {m}"))?;
+    e.reference
+        .cli_args()
+        .map_err(|m| format!("reference: {m}"))?;
     let mut labels = std::collections::BTreeSet::new();
     for s in &e.strategies {
         if s.label.trim().is_empty() || s.name.trim().is_empty() {
@@ -229,7 +237,8 @@ fn validate(e: &Experiment) -> Result<(), String> {
         if !labels.insert(s.label.clone()) {
             return Err(format!("strategy label `{}` is used twice", s.label));
         }
-        s.cli_args().map_err(|m| format!("strategy `{}`: {m}", s.label))?;
+        s.cli_args()
+            .map_err(|m| format!("strategy `{}`: {m}", s.label))?;
     }
     let mut scene_labels = std::collections::BTreeSet::new();
     for s in &e.scenes {
@@ -240,7 +249,10 @@ fn validate(e: &Experiment) -> Result<(), String> {
             return Err(format!("scene label `{}` is used twice", s.label()));
         }
         if s.width == Some(0) || s.height == Some(0) {
-            return Err(format!("scene `{}`: width and height must be positive", s.label()));
+            return Err(format!(
+                "scene `{}`: width and height must be positive",
+                s.label()
+            ));
         }
     }
     if let Some(b) = &e.baseline

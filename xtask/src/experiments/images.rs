@@ -36,7 +36,11 @@ pub fn auto_exposure(px: &[Vec3], unlit: &[bool]) -> f32 {
 }
 
 fn srgb(c: f32) -> u8 {
-    let c = if c.is_finite() { c.clamp(0.0, 1.0) } else { 0.0 };
+    let c = if c.is_finite() {
+        c.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let s = if c <= 0.003_130_8 {
         12.92 * c
     } else {
@@ -124,10 +128,7 @@ impl Canvas {
     pub fn rect(&mut self, x: u32, y: u32, w: u32, h: u32, c: [u8; 3], thick: u32) {
         for t in 0..thick {
             let (x0, y0) = (x as i64 + t as i64, y as i64 + t as i64);
-            let (x1, y1) = (
-                (x + w) as i64 - 1 - t as i64,
-                (y + h) as i64 - 1 - t as i64,
-            );
+            let (x1, y1) = ((x + w) as i64 - 1 - t as i64, (y + h) as i64 - 1 - t as i64);
             for xx in x0..=x1 {
                 self.put(xx, y0, c);
                 self.put(xx, y1, c);
@@ -146,8 +147,8 @@ impl Canvas {
     ) -> Result<(), String> {
         register_font();
         {
-            let root = BitMapBackend::with_buffer(&mut self.buf, (self.w, self.h))
-                .into_drawing_area();
+            let root =
+                BitMapBackend::with_buffer(&mut self.buf, (self.w, self.h)).into_drawing_area();
             for (x, y, size, s) in texts {
                 let style = ("sans-serif", *size as f64).into_font().color(&BLACK);
                 root.draw(&Text::new(s.clone(), (*x, *y), style))
@@ -277,12 +278,7 @@ pub fn comparison_strip(
                     .collect();
                 c.blit(&err_rgb, w, (0, 0, w, h), x, y, tile, map_h);
             }
-            None => texts.push((
-                x as i32,
-                (y + 4) as i32,
-                11,
-                "error map: log relMSE".into(),
-            )),
+            None => texts.push((x as i32, (y + 4) as i32, 11, "error map: log relMSE".into())),
         }
         y += map_h + 4;
         for (li, line) in col.caption.lines().enumerate() {
@@ -374,7 +370,9 @@ where
             .draw_series(LineSeries::new(pts.clone(), colour.stroke_width(2)))
             .map_err(e)?
             .label(s.label.clone())
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], colour.stroke_width(2))
+            });
         chart
             .draw_series(pts.iter().map(|&p| Circle::new(p, 3, colour.filled())))
             .map_err(e)?;
@@ -401,7 +399,9 @@ where
             .draw_series(segs)
             .map_err(e)?
             .label("reference's own error (est.)")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], grey.stroke_width(1)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 18, y)], grey.stroke_width(1))
+            });
     }
     chart
         .configure_series_labels()
@@ -453,7 +453,9 @@ mod tests {
         let a = r[0];
         assert!(a[0] <= 25 && 25 < a[0] + a[2] && a[1] <= 10 && 10 < a[1] + a[2]);
         let b = r[1];
-        assert!(!(b[0] < a[0] + a[2] && a[0] < b[0] + b[2] && b[1] < a[1] + a[2] && a[1] < b[1] + b[2]));
+        assert!(
+            !(b[0] < a[0] + a[2] && a[0] < b[0] + b[2] && b[1] < a[1] + a[2] && a[1] < b[1] + b[2])
+        );
     }
 
     #[test]
@@ -474,7 +476,17 @@ mod tests {
             image: img.clone(),
             error: Some(vec![0.01; (w * h) as usize]),
         }];
-        comparison_strip(&dir.join("s.png"), "t", w, h, &img, &unlit, &[[0, 0, 4]], &cols).unwrap();
+        comparison_strip(
+            &dir.join("s.png"),
+            "t",
+            w,
+            h,
+            &img,
+            &unlit,
+            &[[0, 0, 4]],
+            &cols,
+        )
+        .unwrap();
         assert!(image::open(dir.join("s.png")).is_ok());
         assert!(image::open(dir.join("p.png")).is_ok());
         let _ = std::fs::remove_dir_all(&dir);

@@ -40,12 +40,15 @@ pub fn classify(stderr: &str) -> Failure {
         .trim()
         .to_string();
     let lower = stderr.to_lowercase();
-    if lower.contains("not implemented yet") {
-        Failure::Skip(last)
-    } else if lower.contains("unknown built-in scene") || lower.contains("unknown builtin") {
+    if lower.contains("not implemented yet")
+        || lower.contains("unknown built-in scene")
+        || lower.contains("unknown builtin")
+    {
         Failure::Skip(last)
     } else if lower.contains("unexpected argument") {
-        Failure::Skip(format!("this manylights does not take the flag yet: {last}"))
+        Failure::Skip(format!(
+            "this manylights does not take the flag yet: {last}"
+        ))
     } else {
         Failure::Error(if last.is_empty() {
             "manylights failed with no message".into()
@@ -86,7 +89,10 @@ impl Manylights {
             root.join("target/release/manylights")
         };
         if !exe.exists() {
-            return Err(format!("built manylights but cannot find {}", exe.display()));
+            return Err(format!(
+                "built manylights but cannot find {}",
+                exe.display()
+            ));
         }
         Ok(Manylights { exe, root })
     }

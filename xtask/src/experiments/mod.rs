@@ -209,16 +209,15 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
     let mut skip_strategy: BTreeSet<String> = BTreeSet::new();
     for s in &exp.strategies {
         let reason = match known.iter().find(|(n, _)| n == &s.name) {
-            None => Some(format!("strategy `{}` is unknown to this manylights", s.name)),
+            None => Some(format!(
+                "strategy `{}` is unknown to this manylights",
+                s.name
+            )),
             Some((_, false)) => Some(format!("strategy `{}` is not implemented yet", s.name)),
             Some(_) => {
                 let bad = manylights::unsupported_flags(&s.cli_args()?, &help);
-                (!bad.is_empty()).then(|| {
-                    format!(
-                        "this manylights does not take {} yet",
-                        bad.join(", ")
-                    )
-                })
+                (!bad.is_empty())
+                    .then(|| format!("this manylights does not take {} yet", bad.join(", ")))
             }
         };
         if let Some(r) = reason {
@@ -312,8 +311,7 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
                 let message = match f {
                     Failure::Skip(m) | Failure::Error(m) => m,
                 };
-                say(&multi, format!("reference for {label} failed: {message}"))
-                    .ok();
+                say(&multi, format!("reference for {label} failed: {message}")).ok();
                 notices.push(Notice {
                     what: format!("reference {label}"),
                     skipped,
@@ -334,7 +332,9 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
         std::fs::create_dir_all(d).map_err(|e| format!("cannot create {}: {e}", d.display()))?;
     }
     let total = multi.add(ProgressBar::new(cells.len() as u64));
-    total.set_style(style("cells {pos}/{len} {wide_bar} [{elapsed_precise}, eta {eta}]"));
+    total.set_style(style(
+        "cells {pos}/{len} {wide_bar} [{elapsed_precise}, eta {eta}]",
+    ));
     let mut rendered = 0usize;
     let mut reused = 0usize;
     let mut failed = false;
@@ -400,11 +400,14 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
                 let message = match f {
                     Failure::Skip(m) | Failure::Error(m) => m,
                 };
-                say(&multi, format!(
+                say(
+                    &multi,
+                    format!(
                         "{} {id}: {message}",
                         if skipped { "skipped" } else { "FAILED" }
-                    ))
-                    .ok();
+                    ),
+                )
+                .ok();
                 if skipped {
                     skip_now.insert(cell.strategy.label.clone());
                 } else {
@@ -426,11 +429,14 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
             Ok(r) => {
                 render_core::output::write_json(&path, &serde_json::to_value(&r).unwrap())?;
                 rendered += 1;
-                say(&multi, format!(
+                say(
+                    &multi,
+                    format!(
                         "{id}: relMSE {:.3e} (unlit) {:.3e} (all), {} spp in {:.2} s",
                         r.unlit.rel_mse, r.all.rel_mse, r.spp, r.wall_seconds
-                    ))
-                    .ok();
+                    ),
+                )
+                .ok();
             }
             Err(e) => {
                 failed = true;
@@ -460,7 +466,12 @@ fn measure(
     ref_id: String,
 ) -> Result<CellResult, String> {
     let (w, h, px) = render_core::output::read_exr(exr)?;
-    if (w, h) != (reference.manifest.identity.width, reference.manifest.identity.height) {
+    if (w, h)
+        != (
+            reference.manifest.identity.width,
+            reference.manifest.identity.height,
+        )
+    {
         return Err(format!("render is {w}x{h}, its reference is not"));
     }
     let all = render_core::metrics::error_metrics(&px, &reference.pixels, None).into();
@@ -564,7 +575,9 @@ pub fn merge_into(
                 };
                 if newer && from.canonicalize().ok() != to.canonicalize().ok() {
                     render_core::output::write_atomically(&to, |tmp| {
-                        std::fs::copy(&from, tmp).map(|_| ()).map_err(|e| e.to_string())
+                        std::fs::copy(&from, tmp)
+                            .map(|_| ())
+                            .map_err(|e| e.to_string())
                     })?;
                     if sub == "cells" {
                         copied += 1;
@@ -625,7 +638,10 @@ mod tests {
         assert!(!is_done(&p, "k1", "r2"), "another reference: stale");
         assert!(!is_done(&dir.join("absent.json"), "k1", "r1"));
         std::fs::write(dir.join("broken.json"), "{\"id\":").unwrap();
-        assert!(!is_done(&dir.join("broken.json"), "k1", "r1"), "a partial file is not done");
+        assert!(
+            !is_done(&dir.join("broken.json"), "k1", "r1"),
+            "a partial file is not done"
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 
@@ -641,7 +657,10 @@ mod tests {
         assert_eq!(n, 2);
         assert!(out.join("cells/c1.json").is_file() && out.join("cells/c2.json").is_file());
         // again: nothing newer to copy
-        assert_eq!(merge_into(&[base.join("s1")], &out, &mut notices).unwrap(), 0);
+        assert_eq!(
+            merge_into(&[base.join("s1")], &out, &mut notices).unwrap(),
+            0
+        );
         let _ = std::fs::remove_dir_all(&base);
     }
 }

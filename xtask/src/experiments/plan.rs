@@ -288,7 +288,8 @@ mod tests {
         let count = |p: &str| cells.iter().filter(|c| c.matches(p)).count();
         assert_eq!(count("B c"), 18);
         assert_eq!(count("power"), 18);
-        assert_eq!(count("a__*seed0"), 3);
+        assert_eq!(count("a__*seed0"), 6);
+        assert_eq!(count("a__A__*seed0"), 3);
         assert_eq!(count("t0.25s"), 12);
         assert_eq!(count("nothing"), 0);
     }

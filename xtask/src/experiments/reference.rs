@@ -3,8 +3,8 @@
 //! `ref.png` (preview), `half-a.exr`/`half-b.exr` (not committed) and `manifest.json`, written
 //! last, so a directory without a manifest is an interrupted render.
 use super::manylights::{Failure, Manylights};
-use super::say;
 use super::plan::{hex_hash, slug};
+use super::say;
 use glam::Vec3;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use render_core::metrics::error_metrics;
@@ -107,7 +107,8 @@ pub struct Reference {
 /// Why the cached reference in `dir` cannot be used (`Ok` = valid).
 pub fn check(dir: &Path, identity: &Identity, validity: &Validity) -> Result<Manifest, String> {
     let path = dir.join("manifest.json");
-    let text = std::fs::read_to_string(&path).map_err(|_| "no manifest (never rendered or interrupted)".to_string())?;
+    let text = std::fs::read_to_string(&path)
+        .map_err(|_| "no manifest (never rendered or interrupted)".to_string())?;
     let m: Manifest =
         serde_json::from_str(&text).map_err(|e| format!("unreadable manifest: {e}"))?;
     if &m.identity != identity {
@@ -181,14 +182,17 @@ impl Ensure<'_> {
         } else {
             check(&dir, &self.identity, &self.validity).unwrap_err()
         };
-        say(multi, format!(
+        say(
+            multi,
+            format!(
                 "reference {} ({why}): rendering {} × {} spp with {}",
                 dir.display(),
                 2,
                 self.identity.spp / 2,
                 self.identity.strategy
-            ))
-            .ok();
+            ),
+        )
+        .ok();
         std::fs::create_dir_all(&dir)
             .map_err(|e| Failure::Error(format!("cannot create {}: {e}", dir.display())))?;
         let _ = std::fs::remove_file(dir.join("manifest.json"));
@@ -235,12 +239,9 @@ impl Ensure<'_> {
             wall += json["wall_seconds"].as_f64().unwrap_or(0.0);
             commit = json["git_commit"].as_str().map(str::to_string);
             let (w, h, px) = render_core::output::read_exr(&out).map_err(Failure::Error)?;
-            let unlit = render_core::output::read_mask_png(
-                &dir.join(format!("{name}.mask.png")),
-                w,
-                h,
-            )
-            .map_err(Failure::Error)?;
+            let unlit =
+                render_core::output::read_mask_png(&dir.join(format!("{name}.mask.png")), w, h)
+                    .map_err(Failure::Error)?;
             halves.push((px, unlit));
         }
         let (a, ua) = &halves[0];
@@ -356,7 +357,11 @@ mod tests {
     #[test]
     fn manifest_validity() {
         let dir = tmp("validity");
-        assert!(check(&dir, &identity(), &validity()).unwrap_err().contains("no manifest"));
+        assert!(
+            check(&dir, &identity(), &validity())
+                .unwrap_err()
+                .contains("no manifest")
+        );
         let m = write_valid(&dir);
         assert_eq!(check(&dir, &identity(), &validity()).unwrap(), m);
         assert!((m.own_rel_mse() - 0.01).abs() < 1e-12);
@@ -368,7 +373,11 @@ mod tests {
         assert!(check(&dir, &other, &validity()).is_err());
         let mut v = validity();
         v.scene_content_hash = "changed".into();
-        assert!(check(&dir, &identity(), &v).unwrap_err().contains("scene changed"));
+        assert!(
+            check(&dir, &identity(), &v)
+                .unwrap_err()
+                .contains("scene changed")
+        );
         let mut v = validity();
         v.manylights_version = "manylights 0.2.0".into();
         assert!(check(&dir, &identity(), &v).is_err());
@@ -377,9 +386,17 @@ mod tests {
         assert!(check(&dir, &identity(), &v).is_err());
         // a different commit is recorded but does not invalidate
         std::fs::remove_file(dir.join("mask.png")).unwrap();
-        assert!(check(&dir, &identity(), &validity()).unwrap_err().contains("mask.png"));
+        assert!(
+            check(&dir, &identity(), &validity())
+                .unwrap_err()
+                .contains("mask.png")
+        );
         std::fs::write(dir.join("manifest.json"), "{").unwrap();
-        assert!(check(&dir, &identity(), &validity()).unwrap_err().contains("unreadable"));
+        assert!(
+            check(&dir, &identity(), &validity())
+                .unwrap_err()
+                .contains("unreadable")
+        );
         let _ = std::fs::remove_dir_all(&dir);
     }
 

@@ -306,7 +306,10 @@ mod tests {
         // equal spp: speed-up = (0.04 * 1) / (0.01 * 2) = 2
         let t = format_table(&rows, &cols, &m, "E&K", &Budget::Spp(16), &noise);
         let lines: Vec<&str> = t.lines().collect();
-        assert_eq!(lines[0], "| scene | E&K (baseline) | ours | missing | ref. noise |");
+        assert_eq!(
+            lines[0],
+            "| scene | E&K (baseline) | ours | missing | ref. noise |"
+        );
         assert_eq!(
             lines[2],
             "| sceneA | 4.00e-2 ± 4.00e-3 (1.00×) | **1.00e-2 ± 1.00e-3** (2.00×) | – | 4.00e-4 |"

@@ -153,11 +153,7 @@ pub fn generate(
         if g.is_empty() {
             continue;
         }
-        let _ = writeln!(
-            md,
-            "## Wall seconds / spp reached, {}\n",
-            budget.describe()
-        );
+        let _ = writeln!(md, "## Wall seconds / spp reached, {}\n", budget.describe());
         md.push_str(&report::format_time_table(&rows, &cols, &g));
         md.push('\n');
     }
@@ -276,18 +272,13 @@ fn strip(
         .iter()
         .filter(|c| c.scene == scene && c.seed == exp.seeds[0])
         .collect();
-    let budget = exp
-        .spp
-        .iter()
-        .max()
-        .map(|&n| Budget::Spp(n))
-        .or_else(|| {
-            exp.time_budgets
-                .iter()
-                .copied()
-                .max_by(f64::total_cmp)
-                .map(Budget::Time)
-        });
+    let budget = exp.spp.iter().max().map(|&n| Budget::Spp(n)).or_else(|| {
+        exp.time_budgets
+            .iter()
+            .copied()
+            .max_by(f64::total_cmp)
+            .map(Budget::Time)
+    });
     let Some(budget) = budget else {
         return Ok(None);
     };
@@ -303,7 +294,10 @@ fn strip(
     let mut columns = Vec::new();
     let mut baseline_err = None;
     for col in cols {
-        let Some(c) = mine.iter().find(|c| &c.strategy == col && c.budget == budget) else {
+        let Some(c) = mine
+            .iter()
+            .find(|c| &c.strategy == col && c.budget == budget)
+        else {
             continue;
         };
         let exr = out.join("renders").join(format!("{}.exr", c.id));
