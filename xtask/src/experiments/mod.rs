@@ -86,6 +86,29 @@ pub fn resolve_experiment(name: &str) -> PathBuf {
     }
 }
 
+fn load_experiment(name: &str) -> Result<Experiment, String> {
+    let path = resolve_experiment(name);
+    if !path.exists() {
+        let mut names: Vec<String> = std::fs::read_dir(experiments_dir())
+            .map(|d| {
+                d.filter_map(|e| {
+                    let p = e.ok()?.path();
+                    (p.extension()? == "toml")
+                        .then(|| p.file_stem().map(|s| s.to_string_lossy().into_owned()))?
+                })
+                .collect()
+            })
+            .unwrap_or_default();
+        names.sort();
+        return Err(format!(
+            "no experiment `{name}` ({} does not exist); experiments: {}",
+            path.display(),
+            names.join(", ")
+        ));
+    }
+    config::load(&path)
+}
+
 fn results_dir(exp: &Experiment, given: &Option<PathBuf>) -> PathBuf {
     given
         .clone()
@@ -178,7 +201,7 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
     if args.list {
         return list();
     }
-    let exp = config::load(&resolve_experiment(&args.experiment))?;
+    let exp = load_experiment(&args.experiment)?;
     let out = results_dir(&exp, &args.results);
     let root = repo_root();
     let threads = args.threads.or(exp.threads);
@@ -535,7 +558,7 @@ fn finish(
 }
 
 fn merge(args: MergeArgs) -> Result<ExitCode, String> {
-    let exp = config::load(&resolve_experiment(&args.experiment))?;
+    let exp = load_experiment(&args.experiment)?;
     let out = results_dir(&exp, &args.results);
     let mut notices: Vec<Notice> = std::fs::read_to_string(out.join("notices.json"))
         .ok()
