@@ -6,8 +6,31 @@ fn main() -> std::process::ExitCode {
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report"
             );
+        }
+        Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
+            // brdf-integrals: fits its tables / writes results/brdf-integrals (see its README)
+            let sub = if cmd == "validate-brdf-integrals" {
+                "validate"
+            } else {
+                cmd
+            };
+            let status = std::process::Command::new(env!("CARGO"))
+                .args([
+                    "run",
+                    "--release",
+                    "-p",
+                    "brdf-integrals",
+                    "--bin",
+                    "brdf-tool",
+                    "--",
+                    sub,
+                ])
+                .args(&args[1..])
+                .status()
+                .expect("failed to run cargo");
+            std::process::exit(status.code().unwrap_or(1));
         }
         // issue 6: experiment harness
         Some("run-experiments" | "merge-results") => return experiments::main(&args),

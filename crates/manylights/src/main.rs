@@ -31,6 +31,15 @@ enum Command {
     Scenes,
     /// List the strategies.
     Strategies,
+    /// ∫ over a spherical cap of the un-Fresnelled GGX lobe times cos θ (height-correlated
+    /// Smith), zero below the horizon. Reads CSV rows `alpha,theta_o,cap_x,cap_y,cap_z,cap_cos`
+    /// on stdin (θo in radians, ωo = (sin θo, 0, cos θo), cap axis in the local frame with z the
+    /// normal) and writes one value per row.
+    CapIntegral {
+        /// sptd, ltc or reference
+        #[arg(long, default_value = "sptd")]
+        method: String,
+    },
     /// Error of an EXR against a reference EXR: relMSE and MSE, over all pixels and, with
     /// --mask (a render's `.mask.png`), over the pixels whose camera ray sees no light.
     Compare {
@@ -60,6 +69,7 @@ fn main() -> ExitCode {
             mask,
             json,
         } => compare(&image, &reference, mask.as_deref(), json),
+        Command::CapIntegral { method } => cap_integral(&method),
         Command::Strategies => {
             for s in samplers::strategies() {
                 println!(
@@ -177,5 +187,13 @@ fn compare(
             );
         }
     }
+    Ok(())
+}
+
+fn cap_integral(method: &str) -> anyhow::Result<()> {
+    let method: brdf_integrals::Method = method.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    brdf_integrals::run_batch(method, stdin.lock(), std::io::BufWriter::new(stdout.lock()))?;
     Ok(())
 }

@@ -226,3 +226,54 @@ fn compare_reports_error_against_a_reference() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["all"]["rel_mse"].as_f64().unwrap(), 0.0);
 }
+
+#[test]
+fn cap_integral_batch_agrees_across_methods() {
+    use std::io::Write;
+    let run = |method: &str, input: &str| {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_manylights"))
+            .args(["cap-integral", "--method", method])
+            .stdin(std::process::Stdio::piped())
+            .stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap();
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(input.as_bytes())
+            .unwrap();
+        child.wait_with_output().unwrap()
+    };
+    // A cap of half-angle ~25° around the mirror direction of θo = 0.5, α = 0.1; and the hemisphere.
+    let rows = "0.1,0.5,-0.4794,0,0.8776,0.9\n0.1,0.5,0,0,1,0\n";
+    let values = |m: &str| -> Vec<f64> {
+        let o = run(m, rows);
+        assert!(
+            o.status.success(),
+            "{m}: {}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        String::from_utf8_lossy(&o.stdout)
+            .lines()
+            .map(|l| l.trim().parse().unwrap())
+            .collect()
+    };
+    let (r, s, l) = (values("reference"), values("sptd"), values("ltc"));
+    for k in 0..2 {
+        assert!(r[k] > 0.1, "the lobe peak carries mass: {r:?}");
+        assert!(
+            (s[k] - r[k]).abs() < 0.1 * r[k],
+            "sptd {s:?} vs reference {r:?}"
+        );
+        assert!(
+            (l[k] - r[k]).abs() < 0.1 * r[k],
+            "ltc {l:?} vs reference {r:?}"
+        );
+    }
+    let o = run("sptd", "0.1,0.5,1,2\n");
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("line 1"));
+    let o = run("nope", "");
+    assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("unknown method"));
+}

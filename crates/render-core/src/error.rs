@@ -7,6 +7,8 @@ pub enum SceneError {
     Io { path: String, message: String },
     #[error("malformed glTF {path}: {message}")]
     Gltf { path: String, message: String },
+    #[error("malformed scene composition {path}: {message}")]
+    Composition { path: String, message: String },
     #[error("scene has no triangles and no lights")]
     Empty,
     #[error("non-finite vertex position in mesh `{mesh}`")]

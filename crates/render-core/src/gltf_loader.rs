@@ -122,6 +122,7 @@ pub fn load_gltf_with_report(
         ));
     }
     select_camera(&mut scene, camera)?;
+    scene.stats.warnings.extend(report.warnings.iter().cloned());
     Ok((scene, report))
 }
 
@@ -314,6 +315,9 @@ impl Loader<'_> {
                 continue;
             }
             let (material, uv_spec) = self.material(prim.material())?;
+            if prim.get(&gltf::Semantic::Colors(0)).is_some() {
+                self.report.warn("vertex colours (COLOR_0) ignored".into());
+            }
             let buffers = self.buffers;
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let positions: Vec<Vec3> = match reader.read_positions() {
@@ -479,6 +483,12 @@ impl Loader<'_> {
     fn texture(&mut self, tex: &gltf::Texture, srgb: bool) -> Result<Arc<Texture>, SceneError> {
         let image = tex.source();
         let key = (image.index(), srgb);
+        let sampler = tex.sampler();
+        let repeat = gltf::texture::WrappingMode::Repeat;
+        if sampler.wrap_s() != repeat || sampler.wrap_t() != repeat {
+            self.report
+                .warn("texture wrap modes other than repeat read as repeat".into());
+        }
         if let Some(t) = self.textures.get(&key) {
             return Ok(t.clone());
         }
@@ -1053,6 +1063,37 @@ mod tests {
             Err(SceneError::BadEmission { .. })
         ));
 
+        // Non-finite emission (1e39 overflows f32), bad radii, a bad camera.
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["materials"] = json!([{ "emissiveFactor": [1.0, 1.0, 1.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 1e39 } } }]);
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+        let e = err(load_gltf(&write_gltf("infinite.gltf", doc, &bin), None));
+        assert!(matches!(e, SceneError::BadEmission { .. }), "{e}");
+        for (i, extras) in [json!({ "radius": -0.5 }), json!({ "radius": "big" })]
+            .into_iter()
+            .enumerate()
+        {
+            let (mut doc, bin) = triangle_doc(TRI);
+            doc["extensions"] = json!({ "KHR_lights_punctual": { "lights": [{ "type": "point", "intensity": 1.0 }] } });
+            doc["nodes"] = json!([{ "mesh": 0 }, { "extensions": { "KHR_lights_punctual": { "light": 0 } }, "extras": extras }]);
+            doc["scenes"] = json!([{ "nodes": [0, 1] }]);
+            let e = err(load_gltf(
+                &write_gltf(&format!("radius{i}.gltf"), doc, &bin),
+                None,
+            ));
+            assert!(matches!(e, SceneError::BadLight { .. }), "{e}");
+        }
+        let (mut doc, bin) = triangle_doc(TRI);
+        doc["cameras"] =
+            json!([{ "type": "perspective", "perspective": { "yfov": 4.0, "znear": 0.01 } }]);
+        doc["nodes"] = json!([{ "mesh": 0 }, { "camera": 0 }]);
+        doc["scenes"] = json!([{ "nodes": [0, 1] }]);
+        let e = err(load_gltf(&write_gltf("camera.gltf", doc, &bin), None));
+        assert!(
+            matches!(e, SceneError::Gltf { .. }) && e.to_string().contains("yfov"),
+            "{e}"
+        );
+
         let empty = write_gltf(
             "empty.gltf",
             json!({ "asset": { "version": "2.0" }, "scenes": [{ "nodes": [] }] }),
@@ -1147,6 +1188,17 @@ mod tests {
         assert!((cam.position - Vec3::new(0.0, 1.0, 6.8)).length() < 1e-5);
         assert!((cam.yfov - 19.5f32.to_radians()).abs() < 1e-5);
         assert_eq!((cam.width, cam.height), (512, 512));
+        // The README's camera check: this light lands at raster (82.6, 94.9) of 1024², top left.
+        let d = Vec3::new(-0.999, 1.970, -0.132) - cam.position;
+        let right = cam.forward.cross(cam.up);
+        let tan = (0.5 * cam.yfov).tan();
+        let sx = d.dot(right) / d.dot(cam.forward) / tan;
+        let sy = d.dot(cam.up) / d.dot(cam.forward) / tan;
+        let raster = Vec2::new((sx + 1.0) * 512.0, (1.0 - sy) * 512.0);
+        assert!((raster - Vec2::new(82.6, 94.9)).length() < 0.2, "{raster}");
+        // And the camera's own ray through that raster position points at the light.
+        let dir = cam.ray_direction(raster / 1024.0, 1.0);
+        assert!(dir.dot(d.normalize()) > 1.0 - 1e-6);
     }
 
     #[test]
@@ -1167,10 +1219,80 @@ mod tests {
         );
         assert!(s.triangle_lights < 88_837 / 2, "{s:?}");
         assert_eq!(scene.cameras.len(), 8);
+        assert_eq!(scene.stats.warnings, report.warnings);
         assert!(
             report.warnings.iter().any(|w| w.contains("transmission")),
             "{:?}",
             report.warnings
+        );
+    }
+
+    #[test]
+    fn every_shared_scene_loads_with_its_triangle_count() {
+        // (file, triangles in the SOURCES.md table, lights expected)
+        let table = [
+            ("lamp_lights_punctual/LightsPunctualLamp.glb", 6_000),
+            ("lamp_stained_glass/StainedGlassLamp.glb", 35_132),
+            ("emissive_strength_test/EmissiveStrengthTest.glb", 90),
+            ("cornell_box/cornell_box.glb", 32),
+            ("staircase_wooden/staircase.glb", 262_663),
+            ("staircase_modern_hall/staircase2.glb", 31_247),
+            ("veach_mis/veach_mis.glb", 11_956),
+            ("stanford_bunny/stanford_bunny.glb", 69_451),
+            ("stanford_happy_buddha/happy_buddha_100k.glb", 100_000),
+            ("stanford_dragon/stanford_dragon_100k.glb", 100_000),
+        ];
+        for (file, triangles) in table {
+            let Some(path) = shared_scene(file) else {
+                continue;
+            };
+            let scene = load_gltf(&path, None).unwrap_or_else(|e| panic!("{file}: {e}"));
+            let s = &scene.stats;
+            assert_eq!(
+                scene.triangles.len() + s.degenerate_triangles_skipped,
+                triangles,
+                "{file}"
+            );
+            if file.contains("EmissiveStrength") {
+                assert_eq!(s.triangle_lights, 60);
+            }
+            if file.contains("LightsPunctualLamp") {
+                assert_eq!(s.point_lights, 5);
+            }
+        }
+    }
+
+    #[test]
+    fn external_buffers_and_texture_transforms() {
+        let (mut doc, bin) = triangle_doc(TRI);
+        let bin_path = temp_path("external.bin");
+        std::fs::write(&bin_path, &bin).unwrap();
+        doc["buffers"] = json!([{ "byteLength": bin.len(), "uri": "external.bin" }]);
+        // A 1×1 base colour texture whose transform scales uv by 2 and shifts it by (0.5, 0).
+        let mut png = Vec::new();
+        image::RgbImage::from_raw(1, 1, vec![255, 255, 255])
+            .unwrap()
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .unwrap();
+        std::fs::write(temp_path("white.png"), &png).unwrap();
+        doc["images"] = json!([{ "uri": "white.png" }]);
+        doc["textures"] = json!([{ "source": 0 }]);
+        doc["extensionsUsed"] = json!(["KHR_texture_transform"]);
+        doc["materials"] = json!([{ "pbrMetallicRoughness": { "baseColorTexture": { "index": 0,
+            "extensions": { "KHR_texture_transform": { "scale": [2.0, 2.0], "offset": [0.5, 0.0] } } } } }]);
+        doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+        let path = temp_path("external.gltf");
+        std::fs::write(&path, serde_json::to_vec(&doc).unwrap()).unwrap();
+        let scene = load_gltf(&path, None).unwrap();
+        // uv (0.75, 0.5) → (2.0, 1.0)
+        assert_eq!(scene.triangles[0].uv[1], Vec2::new(2.0, 1.0));
+        assert!(scene.materials[0].base_color_texture.is_some());
+        // Without the external buffer: an error naming the problem.
+        std::fs::remove_file(&bin_path).unwrap();
+        let e = err(load_gltf(&path, None));
+        assert!(
+            matches!(e, SceneError::Gltf { .. }) && e.to_string().contains("buffers"),
+            "{e}"
         );
     }
 }

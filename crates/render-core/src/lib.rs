@@ -13,6 +13,7 @@ pub mod bsdf;
 pub mod builtin;
 pub mod camera;
 pub mod chi2;
+pub mod composition;
 pub mod error;
 pub mod estimator;
 pub mod frame;
@@ -32,10 +33,15 @@ pub mod texture;
 pub use error::SceneError;
 pub use glam::{Vec2, Vec3};
 
-/// Loads a scene named on the command line: `builtin:NAME?key=value&…` or a glTF path.
+/// Loads a scene named on the command line: `builtin:NAME?key=value&…`, a composition file
+/// (`.toml`, see [`composition`]) or a glTF path.
 pub fn load_scene(spec: &str, camera: Option<&str>) -> Result<scene::Scene, SceneError> {
     if spec.starts_with("builtin:") {
         let mut scene = builtin::load_builtin(spec)?;
+        gltf_loader::select_camera(&mut scene, camera)?;
+        Ok(scene)
+    } else if spec.ends_with(".toml") {
+        let mut scene = composition::load_composition(std::path::Path::new(spec))?;
         gltf_loader::select_camera(&mut scene, camera)?;
         Ok(scene)
     } else {

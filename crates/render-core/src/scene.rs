@@ -28,7 +28,7 @@ pub struct Triangle {
 pub struct SceneStats {
     pub triangles: usize,
     pub degenerate_triangles_skipped: usize,
-    /// Input primitives that are not triangles (points, lines), not loaded.
+    /// Input primitives not loaded: points, lines, or no positions.
     pub non_triangle_primitives_skipped: usize,
     pub triangle_lights: usize,
     pub sphere_lights: usize,
@@ -38,6 +38,8 @@ pub struct SceneStats {
     /// Emissive triangles whose emission averages to zero (not lights).
     pub black_emissive_triangles: usize,
     pub total_power_w: f64,
+    /// Input features that were ignored or approximated (e.g. glTF extensions not modelled).
+    pub warnings: Vec<String>,
 }
 
 /// Where a ray met the scene.
@@ -409,9 +411,42 @@ impl SceneBuilder {
         Ok(())
     }
 
-    /// Counts input primitives that were not loaded (points, lines).
+    /// Counts input primitives that were not loaded (points, lines, no positions).
     pub fn count_skipped_primitives(&mut self, n: usize) {
         self.stats.non_triangle_primitives_skipped += n;
+    }
+
+    /// Materials added so far, for composition files that override them after loading a glTF.
+    pub fn materials_mut(&mut self) -> &mut [Material] {
+        &mut self.materials
+    }
+
+    /// Number of materials added so far.
+    pub fn material_count(&self) -> usize {
+        self.materials.len()
+    }
+
+    /// Bounds of the triangles and lights added so far (`None` when empty).
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for t in &self.triangles {
+            for p in t.p {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+        for l in &self.lights {
+            let (a, b) = l.bounds();
+            lo = lo.min(a);
+            hi = hi.max(b);
+        }
+        (lo.x <= hi.x).then_some((lo, hi))
+    }
+
+    /// Forgets the cameras added so far (a composition places its own).
+    pub fn clear_cameras(&mut self) {
+        self.cameras.clear();
     }
 
     pub fn add_camera(&mut self, camera: Camera) {

@@ -62,7 +62,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         let c = Vec3::new(
             uniform(&mut rng, -6.0, 6.0),
             uniform(&mut rng, 2.5, 3.5),
-            uniform(&mut rng, -6.0, 6.0),
+            uniform(&mut rng, -5.8, 6.0),
         );
         let rot = Quat::from_rotation_y(uniform(&mut rng, 0.0, TAU));
         let k = pick(&mut rng, COLORS);

@@ -6,9 +6,15 @@
 //! emitted power (and so the exposure) does not depend on the light count or radius.
 //!
 //! `roughness` is glTF's perceptual roughness: the GGX α is roughness² (roughness 0.1 → α 0.01).
+mod car;
+mod cornell;
 mod diffuse_quads;
 mod glossy_spheres;
+mod grid;
+mod lamp;
 pub mod mesh;
+mod staircase;
+mod statue;
 
 use crate::error::SceneError;
 use crate::material::Material;
@@ -77,6 +83,96 @@ const SCENES: &[Def] = &[
             key("seed", "0", SEED_HELP),
         ],
         build: diffuse_quads::build,
+    },
+    Def {
+        name: "car",
+        description: "glossy car-like body on a glossy ground under a ceiling of small sphere lights and 3 large panels",
+        keys: &[
+            key(
+                "lights",
+                "4000",
+                "number of ceiling sphere lights (the 3 panels come on top)",
+            ),
+            key("radius", "0.02", "radius of each sphere light"),
+            key("roughness", "0.15", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: car::build,
+    },
+    Def {
+        name: "lamp",
+        description: "chandelier of many small bulbs over a glossy table, glossy and diffuse objects and a diffuse room",
+        keys: &[
+            key("lights", "1200", "number of bulbs (sphere lights)"),
+            key("radius", "0.012", "radius of each bulb"),
+            key("roughness", "0.12", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: lamp::build,
+    },
+    Def {
+        name: "statue",
+        description: "ridged torus-knot statue (diffuse + glossy) on a pedestal, lit by many lights around it",
+        keys: &[
+            key(
+                "lights",
+                "2048",
+                "number of sphere lights around the statue",
+            ),
+            key("radius", "0.01", "radius of each sphere light"),
+            key("roughness", "0.2", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: statue::build,
+    },
+    Def {
+        name: "cornell",
+        description: "modified Cornell box: diffuse walls, two very glossy objects, tiny sphere lights spelling letters on the side walls",
+        keys: &[
+            key(
+                "lights",
+                "1494",
+                "number of tiny sphere lights on the side walls",
+            ),
+            key(
+                "radius",
+                "0.001",
+                "radius of each light (the box is 2 units wide)",
+            ),
+            key("roughness", "0.1", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: cornell::build,
+    },
+    Def {
+        name: "staircase",
+        description: "staircase between two walls with small lamps along the steps and a glossy floor",
+        keys: &[
+            key("lights", "1000", "number of small lamps (sphere lights)"),
+            key("radius", "0.015", "radius of each lamp"),
+            key("roughness", "0.1", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: staircase::build,
+    },
+    Def {
+        name: "grid",
+        description: "N sphere lights on a square grid over a glossy plane with a few objects, for scaling (N from 100 to 1e6)",
+        keys: &[
+            key(
+                "lights",
+                "10000",
+                "number of lights, 1 to 1e6 (scientific notation allowed)",
+            ),
+            key(
+                "radius",
+                "auto",
+                "radius of each sphere light; auto = 0.05 x grid spacing (10/ceil(sqrt(N)))",
+            ),
+            key("roughness", "0.2", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: grid::build,
     },
 ];
 
@@ -165,7 +261,7 @@ impl Params {
                     params.count("lights", 1, MAX_LIGHTS)?;
                 }
                 "radius" => {
-                    params.number("radius", 1e-6, 1.0)?;
+                    params.radius_or_auto()?;
                 }
                 "roughness" => {
                     params.number("roughness", 0.0, 1.0)?;
@@ -252,6 +348,20 @@ impl Params {
 
     pub fn radius(&self) -> Result<f32, SceneError> {
         self.number("radius", 1e-6, 1.0)
+    }
+
+    /// The radius, or `None` for `auto` (accepted only where `auto` is the default).
+    pub fn radius_or_auto(&self) -> Result<Option<f32>, SceneError> {
+        let auto_default = self
+            .def
+            .keys
+            .iter()
+            .any(|k| k.name == "radius" && k.default == "auto");
+        if auto_default && self.text("radius") == "auto" {
+            Ok(None)
+        } else {
+            self.radius().map(Some)
+        }
     }
 
     pub fn roughness(&self) -> Result<f32, SceneError> {

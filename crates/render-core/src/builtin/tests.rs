@@ -67,35 +67,46 @@ fn every_builtin_builds_is_deterministic_and_follows_its_keys() {
             cam.width >= 200 && cam.height >= 200 && cam.name != "default",
             "{name}"
         );
-        // The camera sees the scene: its view direction points into the bounds' general direction.
-        let centre = 0.5 * (a.bounds.0 + a.bounds.1);
-        assert!(cam.forward.dot(centre - cam.position) > 0.0, "{name}");
+        // The camera looks at geometry, and every light is above the ground (y = 0).
+        assert!(
+            a.intersect(cam.position, cam.forward, 0.0, f32::INFINITY)
+                .is_some_and(|h| h.material.is_some()),
+            "{name}"
+        );
+        assert!(a.lights.iter().all(|l| l.bounds().0.y > 0.0), "{name}");
 
+        // Emission is normalised: total power depends neither on the count nor on the radius.
+        let mut variants = Vec::new();
         if has("radius") {
             let r = load_builtin(&format!("builtin:{name}?lights=50&radius=0.0123")).unwrap();
             let radii: Vec<f32> = r
                 .lights
                 .iter()
-                .filter_map(|l| {
-                    if let LightShape::Sphere { radius, .. } = l.shape {
-                        Some(radius)
-                    } else {
-                        None
-                    }
+                .filter_map(|l| match l.shape {
+                    LightShape::Sphere { radius, .. } => Some(radius),
+                    _ => None,
                 })
                 .collect();
             assert_eq!(radii.len(), 50, "{name}");
             assert!(radii.iter().all(|&x| x == 0.0123), "{name}");
+            variants.push(r);
         }
         if has("roughness") {
             let r = load_builtin(&format!("builtin:{name}?lights=10&roughness=0.37")).unwrap();
             assert!(r.materials.iter().any(|m| m.roughness == 0.37), "{name}");
+            variants.push(r);
         }
-        // Emission is normalised: total power does not depend on the light count.
-        let few = load_builtin(&format!("builtin:{name}?lights=100")).unwrap();
-        let many = load_builtin(&format!("builtin:{name}?lights=400")).unwrap();
-        let ratio = few.stats.total_power_w / many.stats.total_power_w;
-        assert!((ratio - 1.0).abs() < 0.05, "{name}: power ratio {ratio}");
+        if variants.is_empty() {
+            variants.push(load_builtin(&format!("builtin:{name}?lights=100")).unwrap());
+        }
+        for v in &variants {
+            let ratio = v.stats.total_power_w / a.stats.total_power_w;
+            assert!(
+                (ratio - 1.0).abs() < 0.05,
+                "{name}: power ratio {ratio} ({})",
+                v.name
+            );
+        }
 
         let e = err(load_builtin(&format!("builtin:{name}?bogus=1")));
         assert!(
@@ -179,7 +190,16 @@ fn names_are_unique_and_documented() {
             assert!(!k.is_empty() && !default.is_empty() && !help.is_empty());
         }
     }
-    for required in ["glossy-spheres", "diffuse-quads"] {
+    for required in [
+        "glossy-spheres",
+        "diffuse-quads",
+        "car",
+        "lamp",
+        "statue",
+        "cornell",
+        "staircase",
+        "grid",
+    ] {
         assert!(infos.iter().any(|i| i.name == required), "{required}");
     }
 }
@@ -225,4 +245,157 @@ fn diffuse_quads_are_one_sided_and_face_down_over_diffuse_geometry() {
             .filter(|m| !m.is_emissive())
             .all(|m| m.specular == 0.0)
     );
+}
+
+#[test]
+fn cornell_matches_the_authors_layout_at_its_defaults() {
+    let s = load_builtin("builtin:cornell").unwrap();
+    assert_eq!(s.stats.sphere_lights, 1494);
+    assert_eq!(s.camera(None).unwrap().position, Vec3::new(0.0, 1.0, 6.8));
+    let mut on_left = 0;
+    for l in &s.lights {
+        let LightShape::Sphere { center, radius } = l.shape else {
+            panic!()
+        };
+        assert_eq!(radius, 0.001);
+        assert!((center.x.abs() - 0.9989).abs() < 1e-4, "{center}");
+        assert!(center.y > 0.0 && center.y < 2.0 && center.z.abs() < 1.0);
+        on_left += (center.x < 0.0) as usize;
+        // The authors' radiances, unscaled at their count and radius.
+        let known = [
+            Vec3::new(282.0, 196.5, 105.0),
+            Vec3::new(67.5, 37.5, 256.5),
+            Vec3::new(300.0, 180.0, 225.0),
+        ];
+        assert!(
+            known
+                .iter()
+                .any(|k| (l.emission - *k).abs().max_element() < 1e-3),
+            "{}",
+            l.emission
+        );
+    }
+    assert!(on_left > 400 && on_left < 1100, "{on_left}");
+    let glossy: Vec<_> = s.materials.iter().filter(|m| m.specular > 0.0).collect();
+    assert_eq!(glossy.len(), 2);
+    assert!(
+        glossy
+            .iter()
+            .all(|m| (m.params_at(glam::Vec2::ZERO).alpha - 0.01).abs() < 1e-6)
+    );
+    assert!(
+        s.materials
+            .iter()
+            .filter(|m| m.name == "walls")
+            .all(|m| m.specular == 0.0)
+    );
+}
+
+#[test]
+fn car_has_ceiling_spheres_and_three_panels() {
+    let s = load_builtin("builtin:car?lights=500").unwrap();
+    assert_eq!((s.stats.sphere_lights, s.stats.triangle_lights), (500, 6));
+    for l in &s.lights {
+        if let LightShape::Triangle { normal, .. } = l.shape {
+            assert!((normal - Vec3::NEG_Y).length() < 1e-5);
+        } else {
+            assert!(l.bounds().0.y > 4.0);
+        }
+    }
+}
+
+#[test]
+fn grid_lights_fill_rows_and_scale_their_radius() {
+    let s = load_builtin("builtin:grid?lights=100").unwrap();
+    let centers: Vec<Vec3> = light_points(&s);
+    assert!(
+        centers
+            .iter()
+            .all(|c| c.x.abs() < 5.0 && c.z.abs() < 5.0 && c.y == 2.0)
+    );
+    // Spacing 1: neighbours stay at least half a cell apart with ±0.25 cell jitter.
+    for (i, a) in centers.iter().enumerate() {
+        for b in &centers[i + 1..] {
+            assert!((*a - *b).length() > 0.49);
+        }
+    }
+    let LightShape::Sphere { radius, .. } = s.lights[0].shape else {
+        panic!()
+    };
+    assert!((radius - 0.05).abs() < 1e-6);
+    let s = load_builtin("builtin:grid?lights=10000").unwrap();
+    let LightShape::Sphere { radius, .. } = s.lights[0].shape else {
+        panic!()
+    };
+    assert!((radius - 0.005).abs() < 1e-6);
+    // 7 lights: a 3 × 3 grid, filled row by row.
+    let s = load_builtin("builtin:grid?lights=7").unwrap();
+    assert_eq!(s.stats.sphere_lights, 7);
+    assert!(matches!(
+        err(load_builtin("builtin:glossy-spheres?radius=auto")),
+        SceneError::BadBuiltinParam { .. }
+    ));
+}
+
+/// Uniform light selection, light sampling only: enough to see that light reaches the view.
+struct UniformLights;
+
+impl crate::estimator::DirectLighting for UniformLights {
+    fn name(&self) -> String {
+        "test-uniform".into()
+    }
+
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &crate::estimator::ShadingPoint,
+        rng: &mut crate::rng::SampleStream,
+        ctx: &mut crate::estimator::SampleContext,
+    ) -> Vec3 {
+        let n = scene.lights.len();
+        let i = ((rng.next_f32() * n as f32) as usize).min(n - 1);
+        match scene.lights[i].sample(sp.point(), rng.next_2d()) {
+            Some(s) => sp.shade(scene, &s, ctx.counters) * n as f32 / s.pdf,
+            None => Vec3::ZERO,
+        }
+    }
+}
+
+#[test]
+fn every_builtin_renders_a_lit_image() {
+    use crate::render::{RenderSettings, render};
+    for info in list_builtins() {
+        let scene = load_builtin(&format!("builtin:{}?lights=200", info.name)).unwrap();
+        let camera = scene.camera(None).unwrap();
+        let settings = RenderSettings {
+            width: 32,
+            height: 24,
+            spp: Some(4),
+            seed: 1,
+            time_budget: None,
+            threads: Some(1),
+            camera,
+        };
+        let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
+        // Leave out pixels that see a light directly: the rest is reflected light.
+        let lit: Vec<f32> = r
+            .pixels
+            .iter()
+            .zip(&r.light_fraction)
+            .filter(|(_, f)| **f == 0.0)
+            .map(|(p, _)| crate::light::luminance(*p))
+            .collect();
+        assert!(
+            lit.iter().all(|v| v.is_finite() && *v >= 0.0),
+            "{}",
+            info.name
+        );
+        let mean = lit.iter().sum::<f32>() / lit.len() as f32;
+        let nonzero = lit.iter().filter(|v| **v > 0.0).count() as f32 / lit.len() as f32;
+        assert!(
+            mean > 0.01 && nonzero > 0.3,
+            "{}: mean {mean}, lit fraction {nonzero}",
+            info.name
+        );
+    }
 }
