@@ -346,6 +346,9 @@ where
         .map_err(e)?;
     chart
         .configure_mesh()
+        .x_labels(6)
+        .y_labels(6)
+        .light_line_style(RGBColor(235, 235, 235))
         .x_desc(x_label)
         .y_desc("relMSE (unlit pixels)")
         .y_label_formatter(&|v| format!("{v:.0e}"))
@@ -405,7 +408,7 @@ where
     }
     chart
         .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
+        .position(SeriesLabelPosition::LowerLeft)
         .background_style(WHITE.mix(0.85))
         .border_style(BLACK)
         .label_font(("sans-serif", 13))
