@@ -214,7 +214,7 @@ pub fn format_time_table(
     s
 }
 
-pub const CSV_HEADER: [&str; 20] = [
+pub const CSV_HEADER: [&str; 26] = [
     "id",
     "scene",
     "strategy",
@@ -234,6 +234,12 @@ pub const CSV_HEADER: [&str; 20] = [
     "mse_all",
     "unlit_pixels",
     "reference_noise_unlit",
+    "rays_camera",
+    "rays_shadow",
+    "rays_bsdf",
+    "shading_points",
+    "technique_samples",
+    "strategy_parameters",
     "git_commit",
 ];
 
@@ -266,6 +272,12 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
                 format!("{:e}", c.all.mse),
                 c.unlit.pixels.to_string(),
                 format!("{:e}", c.reference_noise_unlit),
+                c.render["rays"]["camera"].to_string(),
+                c.render["rays"]["shadow"].to_string(),
+                c.render["rays"]["bsdf"].to_string(),
+                c.render["shading_points"].to_string(),
+                c.render["technique_samples"].to_string(),
+                c.render["strategy_parameters"].to_string(),
                 c.render["git_commit"].as_str().unwrap_or("").to_string(),
             ])
             .map_err(|e| e.to_string())?;
