@@ -9,11 +9,13 @@ use crate::{
     BuildError, FLAG_HALF_SPACE, FLAG_LEAF, FLAG_TWO_SIDED, LightBounds, LightTree, MAX_DEPTH,
     Node, NodeExtra,
 };
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use rayon::prelude::*;
 use std::f32::consts::{FRAC_PI_2, PI};
 
 const NUM_BUCKETS: usize = 12;
+/// Nodes with at most this many lights evaluate every sorted split instead of binning.
+const SMALL: usize = NUM_BUCKETS;
 /// Subtrees at least this large are built with `rayon::join`.
 const PAR_SUBTREE: usize = 2048;
 /// Nodes at least this large bin their lights in parallel chunks.
@@ -25,8 +27,8 @@ const AREA_PAD: f32 = 1e-3;
 
 #[derive(Clone, Copy, Debug)]
 struct Prim {
-    min: Vec3,
-    max: Vec3,
+    min: Vec3A,
+    max: Vec3A,
     cone: Cone,
     power: f32,
     light: u32,
@@ -35,7 +37,7 @@ struct Prim {
 
 impl Prim {
     #[inline]
-    fn centroid(&self) -> Vec3 {
+    fn centroid(&self) -> Vec3A {
         (self.min + self.max) * 0.5
     }
 }
@@ -43,10 +45,10 @@ impl Prim {
 /// Aggregate bounds of a set of lights.
 #[derive(Clone, Copy, Debug)]
 struct Agg {
-    min: Vec3,
-    max: Vec3,
-    cmin: Vec3,
-    cmax: Vec3,
+    min: Vec3A,
+    max: Vec3A,
+    cmin: Vec3A,
+    cmax: Vec3A,
     cone: Cone,
     power: f64,
     power_sq: f64,
@@ -56,10 +58,10 @@ struct Agg {
 
 impl Agg {
     const EMPTY: Agg = Agg {
-        min: Vec3::INFINITY,
-        max: Vec3::NEG_INFINITY,
-        cmin: Vec3::INFINITY,
-        cmax: Vec3::NEG_INFINITY,
+        min: Vec3A::INFINITY,
+        max: Vec3A::NEG_INFINITY,
+        cmin: Vec3A::INFINITY,
+        cmax: Vec3A::NEG_INFINITY,
         cone: Cone::EMPTY,
         power: 0.0,
         power_sq: 0.0,
@@ -109,7 +111,7 @@ impl Agg {
     /// SAOH cost term Φ · M_A · M_Ω (surface area with padded extents).
     #[inline]
     fn cost(&self, pad: f32) -> f64 {
-        let e = (self.max - self.min).max(Vec3::splat(pad)).as_dvec3();
+        let e = (self.max - self.min).max(Vec3A::splat(pad)).as_dvec3();
         let area = 2.0 * (e.x * e.y + e.y * e.z + e.z * e.x);
         self.power * area * self.cone.measure() as f64
     }
@@ -146,8 +148,8 @@ fn validate(i: usize, l: &LightBounds) -> Result<Prim, BuildError> {
         return Err(BuildError::ZeroAxis { light: i });
     };
     Ok(Prim {
-        min: l.aabb_min,
-        max: l.aabb_max,
+        min: l.aabb_min.into(),
+        max: l.aabb_max.into(),
         cone: Cone {
             axis,
             theta_o: l.theta_o,
@@ -172,8 +174,8 @@ fn make_node(agg: &Agg, depth: u32, child_or_light: u32, leaf: bool) -> (Node, N
     }
     (
         Node {
-            aabb_min: agg.min,
-            aabb_max: agg.max,
+            aabb_min: agg.min.into(),
+            aabb_max: agg.max.into(),
             radius: 0.5 * (agg.max - agg.min).length(),
             axis: cone.axis,
             power: agg.power as f32,
@@ -209,7 +211,7 @@ fn bucket(c: f32, o: f32, scale: f32) -> usize {
 
 type Bins = [[Agg; NUM_BUCKETS]; 3];
 
-fn bin(prims: &[Prim], origin: Vec3, scale: Vec3, active: [bool; 3]) -> Bins {
+fn bin(prims: &[Prim], origin: Vec3A, scale: Vec3A, active: [bool; 3]) -> Bins {
     let mut bins = [[Agg::EMPTY; NUM_BUCKETS]; 3];
     for p in prims {
         let c = p.centroid();
@@ -242,20 +244,28 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
     // Children sit at depth + 1 and need ceil_log2(k) more levels for k lights.
     let budget = max_depth - (depth + 1);
     if active.iter().any(|&a| a) && n > 2 {
-        let scale = Vec3::select(
-            cext.cmpgt(Vec3::ZERO),
-            Vec3::splat(NUM_BUCKETS as f32) / cext,
-            Vec3::ZERO,
+        let scale = Vec3A::select(
+            cext.cmpgt(Vec3A::ZERO),
+            Vec3A::splat(NUM_BUCKETS as f32) / cext,
+            Vec3A::ZERO,
         );
+        let pad = AREA_PAD * longest;
+        if n <= SMALL {
+            return split_small(prims, cext, longest, ext, pad, budget);
+        }
         let bins = if n >= PAR_BIN {
-            prims
+            // Collected in chunk order and folded sequentially: the cone union is not
+            // associative, and a fixed order keeps the build deterministic.
+            let parts: Vec<Bins> = prims
                 .par_chunks(BIN_CHUNK)
                 .map(|ch| bin(ch, agg.cmin, scale, active))
-                .reduce(|| [[Agg::EMPTY; NUM_BUCKETS]; 3], merge_bins)
+                .collect();
+            parts
+                .into_iter()
+                .fold([[Agg::EMPTY; NUM_BUCKETS]; 3], merge_bins)
         } else {
             bin(prims, agg.cmin, scale, active)
         };
-        let pad = AREA_PAD * longest;
         let mut best: Option<(f64, usize, usize, Agg, Agg)> = None;
         for a in 0..3 {
             if !active[a] {
@@ -271,10 +281,14 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
             }
             let mut left = Agg::EMPTY;
             for i in 0..NUM_BUCKETS - 1 {
+                // An empty bucket repeats the previous candidate's partition.
+                if b[i].count == 0 {
+                    continue;
+                }
                 left.merge(&b[i]);
                 let r = &right[i + 1];
-                if left.count == 0 || r.count == 0 {
-                    continue;
+                if r.count == 0 {
+                    break;
                 }
                 let cost = kr * (left.cost(pad) + r.cost(pad));
                 if cost.is_finite() && best.as_ref().is_none_or(|bst| cost < bst.0) {
@@ -295,11 +309,75 @@ fn split(prims: &mut [Prim], agg: &Agg, depth: u32, max_depth: u32) -> (usize, A
     median_split(prims, cext)
 }
 
-fn median_split(prims: &mut [Prim], cext: Vec3) -> (usize, Agg, Agg) {
+/// Orders lights by centroid along `axis`, ties by light index (deterministic).
+#[inline]
+fn by_axis(axis: usize) -> impl Fn(&Prim, &Prim) -> std::cmp::Ordering {
+    move |p, q| {
+        p.centroid()[axis]
+            .total_cmp(&q.centroid()[axis])
+            .then(p.light.cmp(&q.light))
+    }
+}
+
+/// SAOH for nodes of at most `SMALL` lights: every split of the centroid-sorted order is a
+/// candidate on each axis. That is a superset of the 12 bucket boundaries, and it avoids
+/// setting up 36 buckets for a handful of lights (the bulk of all nodes).
+fn split_small(
+    prims: &mut [Prim],
+    cext: Vec3A,
+    longest: f32,
+    ext: Vec3A,
+    pad: f32,
+    budget: u32,
+) -> (usize, Agg, Agg) {
+    let n = prims.len();
+    let active = [cext.x > 0.0, cext.y > 0.0, cext.z > 0.0];
+    let mut suffix = [Agg::EMPTY; SMALL];
+    // Sort small index arrays rather than the 64-byte lights themselves.
+    let mut order = [[0u8; SMALL]; 3];
+    let mut best: Option<(f64, usize, usize, Agg, Agg)> = None;
+    for a in 0..3 {
+        if !active[a] {
+            continue;
+        }
+        let idx = &mut order[a][..n];
+        for (k, v) in idx.iter_mut().enumerate() {
+            *v = k as u8;
+        }
+        let cmp = by_axis(a);
+        idx.sort_unstable_by(|&i, &j| cmp(&prims[i as usize], &prims[j as usize]));
+        let kr = (longest / ext[a]) as f64;
+        let mut acc = Agg::EMPTY;
+        for i in (1..n).rev() {
+            acc.add(&prims[idx[i] as usize]);
+            suffix[i] = acc;
+        }
+        let mut left = Agg::EMPTY;
+        for i in 0..n - 1 {
+            left.add(&prims[idx[i] as usize]);
+            let cost = kr * (left.cost(pad) + suffix[i + 1].cost(pad));
+            if cost.is_finite() && best.as_ref().is_none_or(|b| cost < b.0) {
+                best = Some((cost, a, i + 1, left, suffix[i + 1]));
+            }
+        }
+    }
+    match best {
+        Some((cost, a, mid, l, r)) if cost > 0.0 && ceil_log2(mid.max(n - mid)) <= budget => {
+            let mut tmp = [prims[0]; SMALL];
+            tmp[..n].copy_from_slice(prims);
+            for (dst, &src) in prims.iter_mut().zip(&order[a][..n]) {
+                *dst = tmp[src as usize];
+            }
+            (mid, l, r)
+        }
+        _ => median_split(prims, cext),
+    }
+}
+
+fn median_split(prims: &mut [Prim], cext: Vec3A) -> (usize, Agg, Agg) {
     let mid = prims.len() / 2;
     if cext.max_element() > 0.0 {
-        let a = cext.max_position();
-        prims.select_nth_unstable_by(mid, |p, q| p.centroid()[a].total_cmp(&q.centroid()[a]));
+        prims.select_nth_unstable_by(mid, by_axis(cext.max_position()));
     }
     let (l, r) = prims.split_at(mid);
     (mid, Agg::of(l), Agg::of(r))
@@ -389,13 +467,11 @@ impl LightTree {
             .collect::<Result<_, _>>()?;
         let num_nodes = 2 * n - 1;
         let root_agg = if n >= PAR_BIN {
-            prims.par_chunks(BIN_CHUNK).map(Agg::of).reduce(
-                || Agg::EMPTY,
-                |mut a, b| {
-                    a.merge(&b);
-                    a
-                },
-            )
+            let parts: Vec<Agg> = prims.par_chunks(BIN_CHUNK).map(Agg::of).collect();
+            parts.iter().fold(Agg::EMPTY, |mut a, b| {
+                a.merge(b);
+                a
+            })
         } else {
             Agg::of(&prims)
         };

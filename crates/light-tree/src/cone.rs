@@ -32,6 +32,7 @@ impl Cone {
 
     /// Smallest cone (in the E&K sense) bounding both; `EMPTY` is the identity, so a
     /// union with it returns the other cone bit for bit.
+    #[inline]
     pub fn union(a: Cone, b: Cone) -> Cone {
         if a.is_empty() {
             return b;
@@ -52,6 +53,15 @@ impl Cone {
                 theta_e,
             };
         }
+        if a.axis == b.axis {
+            return Cone { theta_e, ..a };
+        }
+        Self::union_slow(a, b, theta_e)
+    }
+
+    /// General case of `union`: `a.theta_o >= b.theta_o`, `a` not the full sphere.
+    #[inline(never)]
+    fn union_slow(a: Cone, b: Cone, theta_e: f32) -> Cone {
         let theta_d = angle_between(a.axis, b.axis);
         if (theta_d + b.theta_o).min(PI) <= a.theta_o {
             return Cone {
@@ -86,7 +96,15 @@ impl Cone {
     /// Orientation measure M_Ω = 2π(1−cos θo) + π/2·[2θw sin θo − cos(θo−2θw) − 2θo sin θo + cos θo],
     /// θw = min(θo+θe, π).
     pub fn measure(&self) -> f32 {
+        if self.theta_o >= PI {
+            return 4.0 * PI;
+        }
         let theta_o = self.theta_o.max(0.0);
+        if theta_o == 0.0 {
+            // π/2·(1 − cos 2θw) = π sin²θw
+            let s = self.theta_e.min(PI).sin();
+            return PI * s * s;
+        }
         let theta_w = (theta_o + self.theta_e).min(PI);
         let (so, co) = theta_o.sin_cos();
         2.0 * PI * (1.0 - co)
@@ -131,6 +149,20 @@ mod tests {
             theta_e: FRAC_PI_2,
         };
         assert!((sphere.measure() - 4.0 * PI).abs() < 1e-4);
+        // The fast paths agree with the general formula just inside them.
+        for theta_e in [0.0, 0.3, FRAC_PI_2, 2.5, PI] {
+            for (fast, near) in [(0.0, 1e-4), (PI, PI - 1e-4)] {
+                let m = |theta_o| {
+                    Cone {
+                        axis: Vec3::Z,
+                        theta_o,
+                        theta_e,
+                    }
+                    .measure()
+                };
+                assert!((m(fast) - m(near)).abs() < 2e-3, "{theta_e} {fast}");
+            }
+        }
     }
 
     #[test]

@@ -13,6 +13,10 @@
 //!   node with any node importance.
 //! * [`LightTree::cut`] / [`LightTree::adaptive_cut`]: cuts for adaptive tree splitting.
 //!
+//! A descent that reaches a node whose two children both have zero importance returns `None`
+//! (with conservative bounds, every light below is dark at `x`), so Σ pmf over all lights is
+//! 1 − P(None): exactly 1 without such dead ends, 0 when everything is dark.
+//!
 //! See `README.md` for units, conventions and measured performance.
 
 mod build;

@@ -181,6 +181,26 @@ impl Cut {
 }
 
 impl LightTree {
+    /// Starts loading the children of node `id` (the next level of a descent), so that their
+    /// cache misses overlap the importance evaluations of the current level.
+    #[inline(always)]
+    fn prefetch_children(&self, id: NodeId) {
+        #[cfg(target_arch = "x86_64")]
+        {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let node = &self.nodes[id as usize];
+            if !node.is_leaf() {
+                let base = self.nodes.as_ptr();
+                // SAFETY: prefetching is a hint that never faults; both ids are valid
+                // node indices (children of an interior node), so the pointers are in bounds.
+                unsafe {
+                    _mm_prefetch::<_MM_HINT_T0>(base.add(id as usize + 1) as *const i8);
+                    _mm_prefetch::<_MM_HINT_T0>(base.add(node.child_or_light as usize) as *const i8);
+                }
+            }
+        }
+    }
+
     /// E&K's normalised variance measure ρ ∈ (0, 1] (eqs. 8–10 with the normalisation,
     /// σ² multiplied by N² as in bisml and the GSoC Cycles tree): low ρ = high variance.
     /// Leaves return 1. Distances are in scene units, so τ is scale-dependent as in E&K.
@@ -216,7 +236,11 @@ impl LightTree {
     ///   (one-sided receiver: pass `n` flipped to the side of interest). `n == Vec3::ZERO`
     ///   drops the receiver term (volumes, transmissive BSDFs).
     /// * inside the bounding sphere (d² ≤ r²) both cosines are 1; the squared distance is
-    ///   always max(d², r²/4, 1e-12), the same clamp everywhere.
+    ///   always max(d², r²/4, 1e-12), the same clamp everywhere;
+    /// * in addition (Cycles-style, conservative, also inside the sphere) the importance is 0
+    ///   when the node's box lies wholly behind the receiver's tangent plane, or when the node
+    ///   is one-sided with θo + θe ≤ π/2 and `x` lies behind the box along the axis;
+    /// * for θe > π/2 an emitter cosine ≤ 0 inside the emission range is floored at 1e-3.
     #[inline]
     pub fn importance(&self, node: NodeId, x: Vec3, n: Vec3) -> f32 {
         self.nodes[node as usize].importance(x, n)
@@ -263,6 +287,8 @@ impl LightTree {
                 return Some((node.child_or_light as usize, pmf));
             }
             let (l, r) = (id + 1, node.child_or_light);
+            self.prefetch_children(l);
+            self.prefetch_children(r);
             let il = sanitize(importance(l));
             let ir = sanitize(importance(r));
             let sum = il + ir;
@@ -310,6 +336,8 @@ impl LightTree {
         while id != leaf {
             let node = &self.nodes[id as usize];
             let (l, r) = (id + 1, node.child_or_light);
+            // Only the next node on the trail matters here.
+            self.prefetch_children(if bits & 1 == 0 { l } else { r });
             let il = sanitize(importance(l));
             let ir = sanitize(importance(r));
             let sum = il + ir;

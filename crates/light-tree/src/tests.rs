@@ -136,6 +136,12 @@ fn tree_configs() -> Vec<(usize, Layout, bool)> {
 }
 
 #[test]
+fn node_is_one_cache_line() {
+    assert_eq!(std::mem::size_of::<crate::Node>(), 64);
+    assert_eq!(std::mem::align_of::<crate::Node>(), 64);
+}
+
+#[test]
 fn structure_invariants() {
     let mut rng = Pcg32::seed_from_u64(1);
     for (n, layout, z) in tree_configs() {
@@ -682,4 +688,78 @@ fn all_dark_receiver() {
     // Facing the receiver instead, everything is lit.
     let sum: f32 = (0..30).map(|l| tree.pmf(-x * 5.0, Vec3::ZERO, l)).sum();
     assert!((sum - 1.0).abs() < 1e-5);
+}
+
+/// Two builds of the same input give identical trees, also through the parallel binning
+/// (≥ 65,536 lights) and parallel subtree paths.
+#[test]
+fn build_is_deterministic() {
+    let mut rng = Pcg32::seed_from_u64(10);
+    let lights = rand_lights(&mut rng, 70_000, Layout::Uniform, true);
+    let a = LightTree::build(&lights).unwrap();
+    let b = LightTree::build(&lights).unwrap();
+    assert_eq!(a.nodes(), b.nodes());
+    assert!((0..lights.len()).all(|l| a.bit_trail(l) == b.bit_trail(l)));
+}
+
+/// Unshadowed irradiance from zero-size emitters spread over a large box, estimated with one
+/// light sample. The exact variance Σ f²/p − F² of the tree's estimator must be far below that
+/// of power-proportional sampling, and every light with f > 0 must have p > 0 (unbiased).
+#[test]
+fn tree_beats_power_sampling_on_spread_lights() {
+    let mut rng = Pcg32::seed_from_u64(11);
+    let lights: Vec<LightBounds> = (0..1000)
+        .map(|i| {
+            let p = rand_in_box(&mut rng, 50.0);
+            let mut l = LightBounds::point(p, 0.1 + rng.random::<f32>());
+            if i % 2 == 0 {
+                l.axis = rand_dir(&mut rng);
+                l.theta_o = 0.0;
+            }
+            l
+        })
+        .collect();
+    let tree = LightTree::build(&lights).unwrap();
+    let total_power: f64 = lights.iter().map(|l| l.power as f64).sum();
+    let (mut var_tree, mut var_power) = (0.0f64, 0.0f64);
+    for _ in 0..50 {
+        let x = rand_in_box(&mut rng, 50.0);
+        let n = rand_dir(&mut rng);
+        let f: Vec<f64> = lights
+            .iter()
+            .map(|l| {
+                let d = l.aabb_min - x;
+                let d2 = d.length_squared() as f64;
+                let w = d.normalize();
+                let emit = if l.theta_o == 0.0 {
+                    (-l.axis.dot(w)).max(0.0)
+                } else {
+                    1.0
+                };
+                l.power as f64 * emit as f64 * n.dot(w).max(0.0) as f64 / d2
+            })
+            .collect();
+        let big_f: f64 = f.iter().sum();
+        if big_f == 0.0 {
+            continue;
+        }
+        let (mut m2_tree, mut m2_power) = (0.0, 0.0);
+        for (l, &fl) in f.iter().enumerate() {
+            if fl == 0.0 {
+                continue;
+            }
+            let p = tree.pmf(x, n, l) as f64;
+            assert!(p > 0.0, "light {l} contributes but has pmf 0");
+            m2_tree += fl * fl / p;
+            m2_power += fl * fl / (lights[l].power as f64 / total_power);
+        }
+        // Relative variances, so every receiver weighs the same.
+        var_tree += (m2_tree - big_f * big_f) / (big_f * big_f);
+        var_power += (m2_power - big_f * big_f) / (big_f * big_f);
+    }
+    eprintln!("relative variance: tree {var_tree:.3}, power {var_power:.3}");
+    assert!(
+        var_tree * 5.0 < var_power,
+        "tree {var_tree} power {var_power}"
+    );
 }

@@ -42,6 +42,12 @@ pub struct RenderArgs {
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
     #[arg(long)]
     pub aux: bool,
+    /// Adaptive tree splitting threshold τ (tree-split strategies).
+    #[arg(long, default_value_t = StrategyOptions::default().tau)]
+    pub tau: f32,
+    /// Most clusters in an adaptive light cut (tree-split strategies).
+    #[arg(long, default_value_t = StrategyOptions::default().max_cut)]
+    pub max_cut: usize,
     /// Print ray throughput.
     #[arg(long)]
     pub stats: bool,
@@ -90,7 +96,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         check_writable(p)?;
     }
     let scene = render_core::load_scene(&args.scene, args.camera.as_deref())?;
-    let opts = StrategyOptions::default();
+    let opts = StrategyOptions {
+        tau: args.tau,
+        max_cut: args.max_cut,
+    };
     let strategy = samplers::create(&args.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");

@@ -483,7 +483,7 @@ impl SceneBuilder {
             hi = hi.max(b);
         }
         self.stats.triangles = self.triangles.len();
-        self.stats.total_power_w = self.lights.iter().map(|l| l.power() as f64).sum();
+        self.stats.total_power_w = self.lights.iter().map(|l| l.power() as f64).sum::<f64>() + 0.0; // + 0.0: an empty sum is −0.0
         let accel = Accel::build(&prims);
         Ok(Scene {
             name: self.name,

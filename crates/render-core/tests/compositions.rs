@@ -1,0 +1,36 @@
+//! Every composition file under experiments/scenes loads, when the shared assets it places are
+//! present (CI has no ../shared: then each is skipped with a notice).
+use std::path::Path;
+
+#[test]
+fn shipped_compositions_load() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../experiments/scenes");
+    let shared = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    let mut loaded = 0;
+    for entry in std::fs::read_dir(&dir).unwrap().flatten() {
+        let path = entry.path();
+        if path.extension().is_none_or(|e| e != "toml") {
+            continue;
+        }
+        if !shared.is_dir() {
+            eprintln!("skipping {}: ../shared/scenes is absent", path.display());
+            continue;
+        }
+        let scene = render_core::load_scene(path.to_str().unwrap(), None)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert!(
+            scene.lights.len() >= 1000,
+            "{}: {} lights",
+            path.display(),
+            scene.lights.len()
+        );
+        assert!(!scene.cameras.is_empty(), "{} has a camera", path.display());
+        loaded += 1;
+    }
+    if shared.is_dir() {
+        assert!(
+            loaded >= 5,
+            "expected the five compositions, loaded {loaded}"
+        );
+    }
+}
