@@ -45,6 +45,8 @@ pub fn classify(stderr: &str) -> Failure {
         || lower.contains("unknown builtin")
     {
         Failure::Skip(last)
+    } else if lower.contains("no such file or directory") {
+        Failure::Skip(format!("a file is absent: {last}"))
     } else if lower.contains("unexpected argument") {
         Failure::Skip(format!(
             "this manylights does not take the flag yet: {last}"
@@ -243,6 +245,12 @@ mod tests {
         ));
         assert!(matches!(
             classify("error: unexpected argument '--lambda' found"),
+            Failure::Skip(_)
+        ));
+        assert!(matches!(
+            classify(
+                "error: cannot read scene file a/../../shared/scenes/x.glb: No such file or directory (os error 2)"
+            ),
             Failure::Skip(_)
         ));
         assert!(matches!(classify("error: disk full"), Failure::Error(_)));
