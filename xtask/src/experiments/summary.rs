@@ -309,6 +309,19 @@ fn strip(
             return Err(format!("{} is not {w}x{h}", exr.display()));
         }
         let err = render_core::metrics::rel_mse_map(&px, &reference);
+        let maps = out.join("error-maps");
+        std::fs::create_dir_all(&maps).map_err(|e| e.to_string())?;
+        let rgb: Vec<u8> = err
+            .iter()
+            .zip(&unlit)
+            .flat_map(|(v, u)| images::error_colour(*v, *u))
+            .collect();
+        images::save_png(
+            &maps.join(format!("{}__{}.png", slug(scene), slug(col))),
+            w,
+            h,
+            &rgb,
+        )?;
         if col == exp.baseline() || baseline_err.is_none() {
             baseline_err = Some(err.clone());
         }
