@@ -1,4 +1,5 @@
 //! Project automation (the `cargo xtask` pattern). Subcommands are added by the issues that need them.
+mod contact_sheet;
 mod experiments;
 
 fn main() -> std::process::ExitCode {
@@ -6,7 +7,7 @@ fn main() -> std::process::ExitCode {
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 64 spp) into results/scenes/"
             );
         }
         Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
@@ -34,6 +35,8 @@ fn main() -> std::process::ExitCode {
         }
         // issue 6: experiment harness
         Some("run-experiments" | "merge-results") => return experiments::main(&args),
+        // issue 7: every scene on one sheet
+        Some("contact-sheet") => return contact_sheet::main(&args),
         Some(other) => {
             eprintln!("error: unknown xtask command `{other}` (try `cargo xtask help`)");
             std::process::exit(2);
