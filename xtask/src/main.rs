@@ -1,10 +1,12 @@
 //! Project automation (the `cargo xtask` pattern). Subcommands are added by the issues that need them.
-fn main() {
+mod experiments;
+
+fn main() -> std::process::ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report"
             );
         }
         Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
@@ -30,9 +32,12 @@ fn main() {
                 .expect("failed to run cargo");
             std::process::exit(status.code().unwrap_or(1));
         }
+        // issue 6: experiment harness
+        Some("run-experiments" | "merge-results") => return experiments::main(&args),
         Some(other) => {
             eprintln!("error: unknown xtask command `{other}` (try `cargo xtask help`)");
             std::process::exit(2);
         }
     }
+    std::process::ExitCode::SUCCESS
 }

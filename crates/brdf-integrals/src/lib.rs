@@ -12,7 +12,6 @@
 
 pub mod batch;
 pub mod cap;
-pub mod chi2;
 pub mod fit;
 pub mod ggx;
 pub mod ltc;

@@ -190,8 +190,8 @@ pub fn pdf_cap(pivot: Vec3, cap: &Cap, w: Vec3) -> f32 {
 mod tests {
     use super::*;
     use crate::cap::lens_area_exact;
-    use crate::chi2;
     use crate::qmc::SplitMix64;
+    use chi2_test::{DirectionGrid, chi2_directions_on, sidak_significance};
 
     fn uniform_sphere(rng: &mut SplitMix64) -> DVec3 {
         let z = 1.0 - 2.0 * rng.next_f64();
@@ -293,24 +293,23 @@ mod tests {
         for (i, (pivot, cap)) in cases.into_iter().enumerate() {
             let s = CapSampler::new(pivot, &cap);
             let mut rng = SplitMix64::new(100 + i as u64);
-            let res = chi2::run_test(
-                |_| {
-                    let (w, _) = s.sample([rng.next_f64() as f32, rng.next_f64() as f32]);
-                    w
-                },
+            let grid = DirectionGrid {
+                theta_bins: 20,
+                phi_bins: 40,
+                axis: cap.axis,
+                cos_min: cap.cos_theta as f64,
+                pdf_subdivisions: 16,
+            };
+            let res = chi2_directions_on(
+                &grid,
+                200_000,
+                |_| Some(s.sample([rng.next_f64() as f32, rng.next_f64() as f32]).0),
                 |w| s.pdf(w) as f64,
-                chi2::Chi2Config {
-                    theta_bins: 20,
-                    phi_bins: 40,
-                    samples: 200_000,
-                    significance: 0.01,
-                    tests,
-                    pdf_subdivisions: 16,
-                    axis: cap.axis,
-                    cos_min: cap.cos_theta as f64,
-                },
             );
-            assert!(res.passed, "case {i}: {res:?}");
+            assert!(
+                res.p_value > sidak_significance(0.01, tests),
+                "case {i}: {res:?}"
+            );
         }
     }
 
@@ -322,20 +321,19 @@ mod tests {
         let mut rng = SplitMix64::new(9);
         // claim a uniform pdf in the cap: must be rejected
         let area = cap.solid_angle() as f64;
-        let res = chi2::run_test(
-            |_| s.sample([rng.next_f64() as f32, rng.next_f64() as f32]).0,
+        let grid = DirectionGrid {
+            theta_bins: 20,
+            phi_bins: 40,
+            axis: cap.axis,
+            cos_min: cap.cos_theta as f64,
+            pdf_subdivisions: 16,
+        };
+        let res = chi2_directions_on(
+            &grid,
+            100_000,
+            |_| Some(s.sample([rng.next_f64() as f32, rng.next_f64() as f32]).0),
             |w| if cap.contains(w) { 1.0 / area } else { 0.0 },
-            chi2::Chi2Config {
-                theta_bins: 20,
-                phi_bins: 40,
-                samples: 100_000,
-                significance: 0.01,
-                tests: 1,
-                pdf_subdivisions: 16,
-                axis: cap.axis,
-                cos_min: cap.cos_theta as f64,
-            },
         );
-        assert!(!res.passed, "{res:?}");
+        assert!(res.p_value < 0.01, "{res:?}");
     }
 }

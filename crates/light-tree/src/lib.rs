@@ -20,7 +20,6 @@
 //! See `README.md` for units, conventions and measured performance.
 
 mod build;
-pub mod chi2;
 mod cone;
 mod query;
 #[cfg(test)]

@@ -1,6 +1,10 @@
 //! Statistical and structural tests of the tree (unit tests beside the code).
 
-use crate::chi2::{chi2_test, sidak};
+use chi2_test::{chi2_test, sidak_significance as sidak};
+
+fn counts(observed: &[u64]) -> Vec<f64> {
+    observed.iter().map(|&o| o as f64).collect()
+}
 use crate::{BuildError, Fresh, LightBounds, LightTree, MAX_DEPTH, NodeId, Rescaled};
 use glam::Vec3;
 use rand::{Rng, RngExt, SeedableRng};
@@ -367,7 +371,7 @@ fn sample_frequencies_pass_chi2() {
                 .collect();
             let total: f64 = expected.iter().sum();
             expected.push((samples as f64 - total).max(0.0));
-            let r = chi2_test(&observed, &expected);
+            let r = chi2_test(&counts(&observed), &expected);
             assert!(
                 r.p_value > alpha,
                 "n={n} {layout:?}: chi2 {} dof {} p {}",
@@ -448,7 +452,7 @@ fn subtree_descent_with_both_random_sources() {
                 let mut expected: Vec<f64> =
                     pmfs.iter().map(|&p| p as f64 * samples as f64).collect();
                 expected.push(dead * samples as f64);
-                let r = chi2_test(&observed, &expected);
+                let r = chi2_test(&counts(&observed), &expected);
                 assert!(
                     r.p_value > alpha,
                     "{name} start {start} fresh {fresh}: chi2 {} dof {} p {}",

@@ -2,6 +2,10 @@
 //! in the manner of Mitsuba's `chi2` tests: histogram the samples, integrate the density
 //! over the same bins, pool sparse bins, and compare the statistic with a significance
 //! level corrected for the number of tests (Šidák).
+//!
+//! Shared by every crate of the workspace (as a dev-dependency where the crate itself must not
+//! depend on anything rendering-specific): discrete distributions through [`chi2_test`],
+//! direction samplers through [`chi2_directions`] / [`chi2_directions_on`].
 
 /// Result of one test.
 #[derive(Clone, Debug)]
@@ -151,57 +155,109 @@ pub fn gamma_q(a: f64, x: f64) -> f64 {
     }
 }
 
-/// Histograms directions sampled by `sample` over a (cos θ, φ) grid of `res_theta × res_phi`
-/// bins of the whole sphere and tests them against `pdf` (a solid-angle density), integrated
-/// over each bin with `sub × sub` midpoint quadrature. `sample` returns `None` for a
-/// rejected sample (counted as missing mass, which the density must also account for by
-/// integrating to less than one).
+/// The (cos θ, φ) histogram of directions: `theta_bins × phi_bins` bins over the part of the
+/// sphere with cos θ ≥ `cos_min` about `axis`, the density integrated over each bin with
+/// `pdf_subdivisions²` midpoint samples (and 16× finer where the density has an edge).
+#[derive(Clone, Copy, Debug)]
+pub struct DirectionGrid {
+    pub theta_bins: usize,
+    pub phi_bins: usize,
+    pub axis: glam::Vec3,
+    pub cos_min: f64,
+    pub pdf_subdivisions: usize,
+}
+
+impl DirectionGrid {
+    /// The whole sphere about +z.
+    pub fn sphere(theta_bins: usize, phi_bins: usize, pdf_subdivisions: usize) -> DirectionGrid {
+        DirectionGrid {
+            theta_bins,
+            phi_bins,
+            axis: glam::Vec3::Z,
+            cos_min: -1.0,
+            pdf_subdivisions,
+        }
+    }
+}
+
+/// Histograms directions sampled by `sample` over the whole sphere (see [`DirectionGrid::sphere`])
+/// and tests them against `pdf` (a solid-angle density).
 pub fn chi2_directions(
     n_samples: usize,
     res_theta: usize,
     res_phi: usize,
     sub: usize,
+    sample: impl FnMut(usize) -> Option<glam::Vec3>,
+    pdf: impl Fn(glam::Vec3) -> f64,
+) -> Chi2Outcome {
+    chi2_directions_on(
+        &DirectionGrid::sphere(res_theta, res_phi, sub),
+        n_samples,
+        sample,
+        pdf,
+    )
+}
+
+/// Histograms directions sampled by `sample` on `grid` and tests them against `pdf`.
+/// `sample` returns `None` for a rejected sample; rejected samples and samples outside the
+/// grid share one extra bin whose expectation is the mass the density leaves off the grid.
+pub fn chi2_directions_on(
+    grid: &DirectionGrid,
+    n_samples: usize,
     mut sample: impl FnMut(usize) -> Option<glam::Vec3>,
     pdf: impl Fn(glam::Vec3) -> f64,
 ) -> Chi2Outcome {
+    use glam::DVec3;
     use std::f64::consts::PI;
-    let bins = res_theta * res_phi;
-    let mut observed = vec![0.0; bins + 1];
-    let bin_of = |w: glam::Vec3| {
-        let c = (w.z as f64).clamp(-1.0, 1.0);
-        let t = (((1.0 - c) * 0.5) * res_theta as f64).min(res_theta as f64 - 1.0) as usize;
-        let mut phi = (w.y as f64).atan2(w.x as f64);
+    let (nt, np) = (grid.theta_bins, grid.phi_bins);
+    let axis = grid.axis.as_dvec3().normalize();
+    let tx = if axis.x.abs() < 0.9 {
+        DVec3::X.cross(axis)
+    } else {
+        DVec3::Y.cross(axis)
+    }
+    .normalize();
+    let ty = axis.cross(tx);
+    let range = 1.0 - grid.cos_min;
+    let bins = nt * np;
+    let bin_of = |w: DVec3| -> Option<usize> {
+        let c = w.dot(axis).clamp(-1.0, 1.0);
+        if c < grid.cos_min {
+            return None;
+        }
+        let t = (((1.0 - c) / range) * nt as f64).min(nt as f64 - 1.0) as usize;
+        let mut phi = w.dot(ty).atan2(w.dot(tx));
         if phi < 0.0 {
             phi += 2.0 * PI;
         }
-        let p = ((phi / (2.0 * PI)) * res_phi as f64).min(res_phi as f64 - 1.0) as usize;
-        t * res_phi + p
+        let p = ((phi / (2.0 * PI)) * np as f64).min(np as f64 - 1.0) as usize;
+        Some(t * np + p)
     };
+    let mut observed = vec![0.0; bins + 1];
     for i in 0..n_samples {
-        match sample(i) {
-            Some(w) => observed[bin_of(w)] += 1.0,
+        match sample(i)
+            .map(|w| w.as_dvec3())
+            .filter(|w| w.is_finite())
+            .and_then(bin_of)
+        {
+            Some(b) => observed[b] += 1.0,
             None => observed[bins] += 1.0,
         }
     }
     let mut expected = vec![0.0; bins + 1];
     let mut total = 0.0;
-    for t in 0..res_theta {
-        for p in 0..res_phi {
+    let sub = grid.pdf_subdivisions.max(1);
+    for t in 0..nt {
+        for p in 0..np {
             let integrate = |sub: usize| {
                 let (mut acc, mut zeros) = (0.0, 0usize);
                 for i in 0..sub {
+                    let c = 1.0 - range * (t as f64 + (i as f64 + 0.5) / sub as f64) / nt as f64;
+                    let r = (1.0 - c * c).max(0.0).sqrt();
                     for j in 0..sub {
-                        let c = 1.0
-                            - 2.0 * (t as f64 + (i as f64 + 0.5) / sub as f64) / res_theta as f64;
-                        let phi =
-                            2.0 * PI * (p as f64 + (j as f64 + 0.5) / sub as f64) / res_phi as f64;
-                        let s = (1.0 - c * c).max(0.0).sqrt();
-                        let w = glam::Vec3::new(
-                            (s * phi.cos()) as f32,
-                            (s * phi.sin()) as f32,
-                            c as f32,
-                        );
-                        let v = pdf(w);
+                        let phi = 2.0 * PI * (p as f64 + (j as f64 + 0.5) / sub as f64) / np as f64;
+                        let w = axis * c + (tx * phi.cos() + ty * phi.sin()) * r;
+                        let v = pdf(w.as_vec3());
                         zeros += (v == 0.0) as usize;
                         acc += v;
                     }
@@ -213,9 +269,8 @@ pub fn chi2_directions(
                 // the bin straddles an edge of the support: integrate it much more finely
                 mean = integrate(sub * 16).0;
             }
-            let area = (2.0 / res_theta as f64) * (2.0 * PI / res_phi as f64);
-            let mass = mean * area;
-            expected[t * res_phi + p] = mass * n_samples as f64;
+            let mass = mean * 2.0 * PI * range / bins as f64;
+            expected[t * np + p] = mass * n_samples as f64;
             total += mass;
         }
     }
@@ -237,6 +292,13 @@ mod tests {
         assert!((gamma_q(5.0, 18.307 / 2.0) - 0.05).abs() < 1e-4);
     }
 
+    fn uniform_sphere(u: f32, v: f32) -> glam::Vec3 {
+        let z = 1.0 - 2.0 * u;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * std::f32::consts::PI * v;
+        glam::Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    }
+
     #[test]
     fn detects_a_wrong_density() {
         // Uniform samples on the sphere tested against a cosine-weighted hemisphere pdf.
@@ -252,14 +314,60 @@ mod tests {
             10,
             20,
             4,
-            |_| {
-                Some(crate::sampling::uniform_sphere(glam::Vec2::new(
-                    next(),
-                    next(),
-                )))
-            },
+            |_| Some(uniform_sphere(next(), next())),
             |w| (w.z.max(0.0) as f64) / std::f64::consts::PI,
         );
         assert!(out.p_value < 1e-6, "{out:?}");
+        let mut k = 0u64;
+        let mut next = || {
+            k = k
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (k >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let ok = chi2_directions(
+            20_000,
+            10,
+            20,
+            4,
+            |_| Some(uniform_sphere(next(), next())),
+            |_| 0.25 / std::f64::consts::PI,
+        );
+        assert!(ok.p_value > 1e-3, "the right density passes: {ok:?}");
+    }
+
+    #[test]
+    fn grids_about_other_axes_cover_a_cap() {
+        // Uniform directions in a cap of cos 0.9 about a tilted axis, on a grid over that cap.
+        let axis = glam::Vec3::new(0.3, -0.4, 0.866).normalize();
+        let frame_x = axis.cross(glam::Vec3::X).normalize();
+        let frame_y = axis.cross(frame_x);
+        let mut k = 7u64;
+        let mut next = || {
+            k = k
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (k >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let grid = DirectionGrid {
+            theta_bins: 10,
+            phi_bins: 20,
+            axis,
+            cos_min: 0.9,
+            pdf_subdivisions: 4,
+        };
+        let area = 2.0 * std::f64::consts::PI * 0.1;
+        let out = chi2_directions_on(
+            &grid,
+            20_000,
+            |_| {
+                let c = 1.0 - 0.1 * next();
+                let s = (1.0 - c * c).sqrt();
+                let phi = 2.0 * std::f32::consts::PI * next();
+                Some(axis * c + (frame_x * phi.cos() + frame_y * phi.sin()) * s)
+            },
+            |w| if w.dot(axis) >= 0.9 { 1.0 / area } else { 0.0 },
+        );
+        assert!(out.p_value > 1e-3, "{out:?}");
     }
 }

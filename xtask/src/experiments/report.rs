@@ -1,0 +1,345 @@
+//! Cell results and what is made of them: cells.csv, cells.json, table.md, plots, strips.
+use super::plan::Budget;
+use super::reference::Metric;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+/// `results/<experiment>/cells/<id>.json`: one finished cell.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CellResult {
+    pub id: String,
+    /// Hash of everything that determines the result; a stored cell with another key is stale.
+    pub key: String,
+    pub experiment: String,
+    pub scene: String,
+    pub scene_spec: String,
+    pub strategy: String,
+    pub strategy_name: String,
+    pub strategy_args: Vec<String>,
+    pub budget: Budget,
+    pub seed: u64,
+    pub width: u32,
+    pub height: u32,
+    /// Content id of the reference the cell was measured against.
+    pub reference: String,
+    /// Its directory under references/.
+    pub reference_dir: String,
+    pub reference_noise_unlit: f64,
+    pub all: Metric,
+    pub unlit: Metric,
+    pub spp: u64,
+    pub wall_seconds: f64,
+    pub cpu_seconds: f64,
+    /// The render's own JSON (stats, rays, technique samples, parameters, commit).
+    pub render: serde_json::Value,
+}
+
+/// Mean and sample standard deviation.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Stat {
+    pub mean: f64,
+    pub std: f64,
+    pub n: usize,
+}
+
+impl Stat {
+    pub fn of(v: &[f64]) -> Stat {
+        let n = v.len();
+        if n == 0 {
+            return Stat::default();
+        }
+        let mean = v.iter().sum::<f64>() / n as f64;
+        let std = if n > 1 {
+            (v.iter().map(|x| (x - mean) * (x - mean)).sum::<f64>() / (n - 1) as f64).sqrt()
+        } else {
+            0.0
+        };
+        Stat { mean, std, n }
+    }
+}
+
+/// One table entry: a scene × strategy × budget over its seeds.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Entry {
+    pub error: Stat,
+    pub seconds: f64,
+    pub spp: f64,
+}
+
+/// What the pixels of a table are.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Pixels {
+    Unlit,
+    All,
+}
+
+pub fn entry(cells: &[&CellResult], pixels: Pixels) -> Entry {
+    let errs: Vec<f64> = cells
+        .iter()
+        .map(|c| match pixels {
+            Pixels::Unlit => c.unlit.rel_mse,
+            Pixels::All => c.all.rel_mse,
+        })
+        .collect();
+    let n = cells.len().max(1) as f64;
+    Entry {
+        error: Stat::of(&errs),
+        seconds: cells.iter().map(|c| c.wall_seconds).sum::<f64>() / n,
+        spp: cells.iter().map(|c| c.spp as f64).sum::<f64>() / n,
+    }
+}
+
+pub fn sci(v: f64) -> String {
+    if v == 0.0 {
+        "0".into()
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// Speed-up of `e` over the baseline `b`: at equal time the ratio of errors; at equal spp the
+/// ratio of error × seconds (the time the baseline needs for the same error, over ours).
+pub fn speedup(e: &Entry, b: &Entry, budget: &Budget) -> Option<f64> {
+    if e.error.mean <= 0.0 || b.error.mean <= 0.0 {
+        return None;
+    }
+    Some(match budget {
+        Budget::Time(_) => b.error.mean / e.error.mean,
+        Budget::Spp(_) => {
+            if e.seconds <= 0.0 || b.seconds <= 0.0 {
+                return None;
+            }
+            (b.error.mean * b.seconds) / (e.error.mean * e.seconds)
+        }
+    })
+}
+
+/// A paper-style markdown table: rows scenes, columns strategies (then the reference noise),
+/// mean ± std over seeds, the lowest error per row in bold, the speed-up vs the baseline column
+/// in parentheses.
+pub fn format_table(
+    rows: &[String],
+    cols: &[String],
+    entries: &BTreeMap<(String, String), Entry>,
+    baseline: &str,
+    budget: &Budget,
+    ref_noise: &BTreeMap<String, f64>,
+) -> String {
+    let mut s = String::new();
+    let _ = write!(s, "| scene |");
+    for c in cols {
+        let mark = if c == baseline { " (baseline)" } else { "" };
+        let _ = write!(s, " {c}{mark} |");
+    }
+    let _ = writeln!(s, " ref. noise |");
+    let _ = write!(s, "|---|");
+    for _ in cols {
+        let _ = write!(s, "---:|");
+    }
+    let _ = writeln!(s, "---:|");
+    for r in rows {
+        let _ = write!(s, "| {r} |");
+        let row: Vec<Option<&Entry>> = cols
+            .iter()
+            .map(|c| entries.get(&(r.clone(), c.clone())))
+            .collect();
+        let best = row
+            .iter()
+            .flatten()
+            .map(|e| e.error.mean)
+            .fold(f64::INFINITY, f64::min);
+        let base = entries.get(&(r.clone(), baseline.to_string()));
+        for e in &row {
+            match e {
+                None => {
+                    let _ = write!(s, " – |");
+                }
+                Some(e) => {
+                    let mut v = sci(e.error.mean);
+                    if e.error.n > 1 {
+                        v = format!("{v} ± {}", sci(e.error.std));
+                    }
+                    if e.error.mean == best {
+                        v = format!("**{v}**");
+                    }
+                    if let Some(b) = base
+                        && let Some(x) = speedup(e, b, budget)
+                    {
+                        v = format!("{v} ({x:.2}×)");
+                    }
+                    let _ = write!(s, " {v} |");
+                }
+            }
+        }
+        match ref_noise.get(r) {
+            Some(n) => {
+                let _ = writeln!(s, " {} |", sci(*n));
+            }
+            None => {
+                let _ = writeln!(s, " – |");
+            }
+        }
+    }
+    s
+}
+
+/// Seconds and spp reached, same layout.
+pub fn format_time_table(
+    rows: &[String],
+    cols: &[String],
+    entries: &BTreeMap<(String, String), Entry>,
+) -> String {
+    let mut s = String::from("| scene |");
+    for c in cols {
+        let _ = write!(s, " {c} |");
+    }
+    s.push_str("\n|---|");
+    for _ in cols {
+        s.push_str("---:|");
+    }
+    s.push('\n');
+    for r in rows {
+        let _ = write!(s, "| {r} |");
+        for c in cols {
+            match entries.get(&(r.clone(), c.clone())) {
+                Some(e) => {
+                    let _ = write!(s, " {:.2} s / {:.0} spp |", e.seconds, e.spp);
+                }
+                None => s.push_str(" – |"),
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+pub const CSV_HEADER: [&str; 26] = [
+    "id",
+    "scene",
+    "strategy",
+    "strategy_name",
+    "strategy_args",
+    "budget",
+    "budget_value",
+    "seed",
+    "width",
+    "height",
+    "spp",
+    "wall_seconds",
+    "cpu_seconds",
+    "rel_mse_unlit",
+    "mse_unlit",
+    "rel_mse_all",
+    "mse_all",
+    "unlit_pixels",
+    "reference_noise_unlit",
+    "rays_camera",
+    "rays_shadow",
+    "rays_bsdf",
+    "shading_points",
+    "technique_samples",
+    "strategy_parameters",
+    "git_commit",
+];
+
+pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), String> {
+    render_core::output::write_atomically(path, |tmp| {
+        let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
+        w.write_record(CSV_HEADER).map_err(|e| e.to_string())?;
+        for c in cells {
+            let (kind, value) = match c.budget {
+                Budget::Spp(n) => ("spp", n.to_string()),
+                Budget::Time(t) => ("time", t.to_string()),
+            };
+            w.write_record([
+                c.id.clone(),
+                c.scene.clone(),
+                c.strategy.clone(),
+                c.strategy_name.clone(),
+                c.strategy_args.join(" "),
+                kind.to_string(),
+                value,
+                c.seed.to_string(),
+                c.width.to_string(),
+                c.height.to_string(),
+                c.spp.to_string(),
+                format!("{:.4}", c.wall_seconds),
+                format!("{:.4}", c.cpu_seconds),
+                format!("{:e}", c.unlit.rel_mse),
+                format!("{:e}", c.unlit.mse),
+                format!("{:e}", c.all.rel_mse),
+                format!("{:e}", c.all.mse),
+                c.unlit.pixels.to_string(),
+                format!("{:e}", c.reference_noise_unlit),
+                c.render["rays"]["camera"].to_string(),
+                c.render["rays"]["shadow"].to_string(),
+                c.render["rays"]["bsdf"].to_string(),
+                c.render["shading_points"].to_string(),
+                c.render["technique_samples"].to_string(),
+                c.render["strategy_parameters"].to_string(),
+                c.render["git_commit"].as_str().unwrap_or("").to_string(),
+            ])
+            .map_err(|e| e.to_string())?;
+        }
+        w.flush().map_err(|e| e.to_string())
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn e(mean: f64, std: f64, n: usize, seconds: f64) -> Entry {
+        Entry {
+            error: Stat { mean, std, n },
+            seconds,
+            spp: 16.0,
+        }
+    }
+
+    #[test]
+    fn stats() {
+        let s = Stat::of(&[1.0, 2.0, 3.0]);
+        assert_eq!((s.mean, s.std, s.n), (2.0, 1.0, 3));
+        assert_eq!(Stat::of(&[5.0]).std, 0.0);
+    }
+
+    #[test]
+    fn table_bolds_the_best_and_gives_speedups() {
+        let rows = vec!["sceneA".to_string(), "sceneB".to_string()];
+        let cols = vec!["E&K".to_string(), "ours".to_string(), "missing".to_string()];
+        let mut m = BTreeMap::new();
+        m.insert(("sceneA".into(), "E&K".into()), e(0.04, 0.004, 2, 1.0));
+        m.insert(("sceneA".into(), "ours".into()), e(0.01, 0.001, 2, 2.0));
+        m.insert(("sceneB".into(), "E&K".into()), e(0.02, 0.0, 1, 1.0));
+        m.insert(("sceneB".into(), "ours".into()), e(0.03, 0.0, 1, 1.0));
+        let noise = BTreeMap::from([("sceneA".to_string(), 0.0004)]);
+        // equal spp: speed-up = (0.04 * 1) / (0.01 * 2) = 2
+        let t = format_table(&rows, &cols, &m, "E&K", &Budget::Spp(16), &noise);
+        let lines: Vec<&str> = t.lines().collect();
+        assert_eq!(
+            lines[0],
+            "| scene | E&K (baseline) | ours | missing | ref. noise |"
+        );
+        assert_eq!(
+            lines[2],
+            "| sceneA | 4.00e-2 ± 4.00e-3 (1.00×) | **1.00e-2 ± 1.00e-3** (2.00×) | – | 4.00e-4 |"
+        );
+        assert_eq!(
+            lines[3],
+            "| sceneB | **2.00e-2** (1.00×) | 3.00e-2 (0.67×) | – | – |"
+        );
+        // equal time: speed-up = error ratio = 4
+        let t = format_table(&rows, &cols, &m, "E&K", &Budget::Time(1.0), &noise);
+        assert!(t.contains("**1.00e-2 ± 1.00e-3** (4.00×)"), "{t}");
+    }
+
+    #[test]
+    fn time_table() {
+        let rows = vec!["s".to_string()];
+        let cols = vec!["a".to_string()];
+        let m = BTreeMap::from([(("s".to_string(), "a".to_string()), e(0.1, 0.0, 1, 1.5))]);
+        assert!(format_time_table(&rows, &cols, &m).contains("| s | 1.50 s / 16 spp |"));
+    }
+}
