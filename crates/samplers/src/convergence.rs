@@ -18,11 +18,25 @@ pub fn region_mean(
     y1: u32,
     unlit_only: bool,
 ) -> (f64, f64) {
+    region_mean_excluding(r, x0, y0, x1, y1, |i| {
+        unlit_only && r.light_fraction[i] > 0.0
+    })
+}
+
+/// [`region_mean`] leaving out the pixels for which `excluded(index)` holds.
+pub fn region_mean_excluding(
+    r: &RenderResult,
+    x0: u32,
+    y0: u32,
+    x1: u32,
+    y1: u32,
+    excluded: impl Fn(usize) -> bool,
+) -> (f64, f64) {
     let (mut sum, mut var, mut n) = (0.0, 0.0, 0usize);
     for y in y0..y1 {
         for x in x0..x1 {
             let i = (y * r.width + x) as usize;
-            if unlit_only && r.light_fraction[i] > 0.0 {
+            if excluded(i) {
                 continue;
             }
             sum += luminance(r.pixels[i]);
@@ -43,7 +57,10 @@ pub fn region_mean(
 
 /// Compares two renders over a grid of `cells × cells` regions plus the whole image.
 /// Returns a description of every region whose means differ by more than `z` combined
-/// standard errors.
+/// standard errors. Both means leave out the pixels where *either* render saw a light: the
+/// light mask grows with the sample count (more jittered rays graze the lights), and the
+/// bright pixels next to lights would otherwise bias the comparison of renders of different
+/// sample counts.
 pub fn compare(a: &RenderResult, b: &RenderResult, cells: u32, z: f64) -> Vec<String> {
     assert_eq!((a.width, a.height), (b.width, b.height));
     let mut failures = Vec::new();
@@ -59,8 +76,9 @@ pub fn compare(a: &RenderResult, b: &RenderResult, cells: u32, z: f64) -> Vec<St
         }
     }
     for (x0, y0, x1, y1) in regions {
-        let (ma, sa) = region_mean(a, x0, y0, x1, y1, true);
-        let (mb, sb) = region_mean(b, x0, y0, x1, y1, true);
+        let lit = |i: usize| a.light_fraction[i] > 0.0 || b.light_fraction[i] > 0.0;
+        let (ma, sa) = region_mean_excluding(a, x0, y0, x1, y1, lit);
+        let (mb, sb) = region_mean_excluding(b, x0, y0, x1, y1, lit);
         let se = (sa * sa + sb * sb).sqrt();
         if (ma - mb).abs() > z * se + 1e-6 * ma.abs().max(mb.abs()) {
             failures.push(format!(

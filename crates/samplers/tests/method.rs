@@ -427,3 +427,70 @@ fn make_glossy_mask() {
         excluded.iter().filter(|&&e| e == 0.0).count()
     );
 }
+
+/// The issue-7 built-ins, small and rough enough that 96 spp is past the heavy-tailed regime
+/// (at 24 spp the lamp's image mean still wanders by ±3 estimated standard errors with the
+/// seed, for every strategy).
+#[test]
+fn mis3_converges_on_the_other_builtins() {
+    let d = StrategyOptions::default();
+    for spec in [
+        "builtin:car?lights=64&radius=0.1&roughness=0.5",
+        "builtin:lamp?lights=64&radius=0.05&roughness=0.5",
+        "builtin:statue?lights=64&radius=0.1&roughness=0.5",
+        // builtin:cornell (lights 1 mm from the walls) is left out: its hot spots make the
+        // per-pixel variance estimates unreliable at test sample counts (3.1 SE at
+        // 4096 vs 512 spp); at 4096 spp power+bsdf and mis3-adaptive agree within 1.8 SE.
+        "builtin:staircase?lights=64&radius=0.05&roughness=0.5",
+        "builtin:grid?lights=64&roughness=0.5",
+    ] {
+        let scene = render_core::load_scene(spec, None).unwrap();
+        let size = Some((24, 18));
+        let reference = render_opts(&scene, "power+bsdf", &d, 1024, 1, size);
+        let r = render_opts(&scene, "mis3-adaptive", &d, 96, 2, size);
+        let failures = compare(&reference, &r, 2, 3.0);
+        assert!(
+            failures.is_empty(),
+            "mis3-adaptive vs power+bsdf on {spec}:\n{}",
+            failures.join("\n")
+        );
+    }
+}
+/// Diagnostic: image means ± SE of several strategies and sample counts on `SCENE` (default
+/// the statue). It showed that means over each render's *own* unlit pixels drift with the
+/// sample count (the light mask grows), which `convergence::compare` now avoids by leaving out
+/// the pixels either render saw a light in.
+/// Run: `SCENE=... cargo test -p samplers --test method strategy_means -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn strategy_means() {
+    let d = StrategyOptions::default();
+    let scene = render_core::load_scene(
+        &std::env::var("SCENE")
+            .unwrap_or_else(|_| "builtin:statue?lights=64&radius=0.1&roughness=0.5".into()),
+        None,
+    )
+    .unwrap();
+    let mc1 = StrategyOptions {
+        max_cut: 1,
+        ..d.clone()
+    };
+    let big = StrategyOptions {
+        delta: 100.0,
+        ..d.clone()
+    };
+    for (name, spp, seed, d) in [
+        ("tree-split+bsdf", 512, 2, &d),
+        ("tree-split+bsdf", 512, 3, &d),
+        ("mis3-adaptive", 1024, 2, &d),
+        ("mis3-equal", 2048, 4, &mc1),
+        ("mis3-equal", 2048, 4, &big),
+    ] {
+        let r = render_opts(&scene, name, d, spp, seed, Some((24, 18)));
+        eprintln!(
+            "{name} {spp}: {:?} {:?}",
+            samplers::convergence::region_mean(&r, 0, 9, 12, 18, true),
+            samplers::convergence::region_mean(&r, 0, 0, 24, 18, true)
+        );
+    }
+}

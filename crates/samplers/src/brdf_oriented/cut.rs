@@ -69,11 +69,14 @@ impl BoCut {
         self.cdf.last().copied().unwrap_or(0.0)
     }
 
-    /// Probability of picking cluster `k`.
+    /// Probability of picking cluster `k`: the width of its interval of the (f32) cdf over
+    /// the total, exactly what [`BoCut::pick`] realises (not I_k/total, which differs from the
+    /// interval width by rounding for clusters far below the total).
     pub fn cluster_pmf(&self, k: usize) -> f32 {
         let total = self.total();
         if total > 0.0 {
-            self.terms[k].importance / total
+            let lo = if k > 0 { self.cdf[k - 1] } else { 0.0 };
+            (self.cdf[k] - lo) / total
         } else {
             0.0
         }
@@ -87,18 +90,18 @@ impl BoCut {
         }
         let target = u * total;
         let mut k = self.cdf.partition_point(|&c| c <= target);
-        // Skip zero-width intervals (rounding) and stay in range.
+        // Stay in range (u·total can round up to total), skipping zero-width intervals.
         k = k.min(self.cdf.len() - 1);
-        while self.terms[k].importance <= 0.0 && k > 0 {
+        while k > 0 && self.cdf[k] <= self.cdf[k - 1] {
             k -= 1;
         }
-        let imp = self.terms[k].importance;
-        if !(imp > 0.0) {
+        let lo = if k > 0 { self.cdf[k - 1] } else { 0.0 };
+        let width = self.cdf[k] - lo;
+        if !(width > 0.0) {
             return None;
         }
-        let lo = if k > 0 { self.cdf[k - 1] } else { 0.0 };
-        let rest = ((target - lo) / imp).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
-        Some((k, imp / total, rest))
+        let rest = ((target - lo) / width).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        Some((k, width / total, rest))
     }
 
     /// UB = clamp(max over the cut of the cached glossy cap integrals, 0, 1) (heuristic 1).

@@ -189,6 +189,15 @@ where
                 s.is_delta,
                 TECHNIQUE_LS,
             );
+            debug_assert!(
+                {
+                    let replay = self.ls.pmf(&ls_state, sp, light)
+                        * scene.lights[light as usize].pdf(x, s.point, s.normal);
+                    let own = pmf * s.pdf;
+                    s.is_delta || (replay - own).abs() <= 1e-3 * own
+                },
+                "LS pdf at sampling vs replay"
+            );
             p[TECHNIQUE_LS] = pmf * s.pdf;
             taken.push(Taken {
                 tech: TECHNIQUE_LS,
