@@ -28,7 +28,7 @@ const TILE_W: u32 = 240;
 const TILE_H: u32 = 180;
 const LABEL_H: u32 = 18;
 const COLUMNS: u32 = 4;
-const SPP: &str = "64";
+const SPP: &str = "16";
 
 pub fn main(_args: &[String]) -> ExitCode {
     match run() {
