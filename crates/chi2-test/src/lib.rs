@@ -292,6 +292,17 @@ mod tests {
         assert!((gamma_q(5.0, 18.307 / 2.0) - 0.05).abs() < 1e-4);
     }
 
+    /// A small deterministic uniform generator for the tests (64-bit LCG, top 24 bits).
+    fn lcg(seed: u64) -> impl FnMut() -> f32 {
+        let mut k = seed;
+        move || {
+            k = k
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (k >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
     fn uniform_sphere(u: f32, v: f32) -> glam::Vec3 {
         let z = 1.0 - 2.0 * u;
         let r = (1.0 - z * z).max(0.0).sqrt();
@@ -302,13 +313,7 @@ mod tests {
     #[test]
     fn detects_a_wrong_density() {
         // Uniform samples on the sphere tested against a cosine-weighted hemisphere pdf.
-        let mut k = 0u64;
-        let mut next = || {
-            k = k
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (k >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = lcg(0);
         let out = chi2_directions(
             20_000,
             10,
@@ -318,13 +323,7 @@ mod tests {
             |w| (w.z.max(0.0) as f64) / std::f64::consts::PI,
         );
         assert!(out.p_value < 1e-6, "{out:?}");
-        let mut k = 0u64;
-        let mut next = || {
-            k = k
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (k >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = lcg(0);
         let ok = chi2_directions(
             20_000,
             10,
@@ -342,13 +341,7 @@ mod tests {
         let axis = glam::Vec3::new(0.3, -0.4, 0.866).normalize();
         let frame_x = axis.cross(glam::Vec3::X).normalize();
         let frame_y = axis.cross(frame_x);
-        let mut k = 7u64;
-        let mut next = || {
-            k = k
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (k >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut next = lcg(7);
         let grid = DirectionGrid {
             theta_bins: 10,
             phi_bins: 20,
