@@ -377,22 +377,7 @@ mod tests {
 
     #[test]
     fn table_lookup_reproduces_grid_points() {
-        let t = default_table();
-        for &(i, j) in &[(0usize, 0usize), (5, 40), (63, 63), (31, 2), (62, 17)] {
-            let (theta, sa) = t.grid_point(i, j);
-            let c = t.cell(i, j);
-            for mode in [Lookup::Bilinear, Lookup::Nearest] {
-                let l = t.lookup(theta, sa * sa, mode);
-                for k in 0..3 {
-                    assert!(
-                        (l[k] - c[k]).abs() <= 1e-5 * c[k].abs().max(1.0),
-                        "({i},{j}) ch {k}: {} vs {}",
-                        l[k],
-                        c[k]
-                    );
-                }
-            }
-        }
+        crate::table::assert_lookup_reproduces_grid_points(&default_table(), 3);
     }
 
     #[test]

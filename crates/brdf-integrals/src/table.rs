@@ -119,3 +119,24 @@ impl<const C: usize> Table<C> {
         )
     }
 }
+
+/// Both lookup modes return a table's own values at its grid points, for the first
+/// `channels` channels (the tests of every fitted table).
+#[cfg(test)]
+pub(crate) fn assert_lookup_reproduces_grid_points<const C: usize>(t: &Table<C>, channels: usize) {
+    for &(i, j) in &[(0usize, 0usize), (5, 40), (63, 63), (31, 2), (62, 17)] {
+        let (theta, sa) = t.grid_point(i, j);
+        let c = t.cell(i, j);
+        for mode in [Lookup::Bilinear, Lookup::Nearest] {
+            let l = t.lookup(theta, sa * sa, mode);
+            for k in 0..channels {
+                assert!(
+                    (l[k] - c[k]).abs() <= 1e-5 * c[k].abs().max(1.0),
+                    "({i},{j}) ch {k}: {} vs {}",
+                    l[k],
+                    c[k]
+                );
+            }
+        }
+    }
+}
