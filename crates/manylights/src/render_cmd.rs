@@ -3,7 +3,7 @@ use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use render_core::output::{write_exr, write_json, write_mask_png, write_png};
-use render_core::render::{RenderSettings, render};
+use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
 use samplers::StrategyOptions;
 use std::path::{Path, PathBuf};
 
@@ -37,6 +37,10 @@ pub struct RenderArgs {
     /// Render passes until this many seconds are spent.
     #[arg(long)]
     pub time_budget: Option<f64>,
+    /// What --time-budget counts: wall time, or the process's CPU time per worker thread
+    /// (fair equal-time comparisons on a machine shared with other jobs).
+    #[arg(long, value_enum, default_value = "wall")]
+    pub budget_clock: BudgetClockArg,
     #[arg(long)]
     pub threads: Option<usize>,
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
@@ -85,6 +89,12 @@ pub struct MethodArgs {
     /// Turn off heuristic 2 (P(BO) from hits and misses); P(BO) = 1/2 instead.
     #[arg(long)]
     pub no_adaptive_split: bool,
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug)]
+pub enum BudgetClockArg {
+    Wall,
+    Cpu,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -203,7 +213,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         height,
         spp,
         seed: args.seed,
-        time_budget: args.time_budget,
+        time_budget: args.time_budget.map(|seconds| TimeBudget {
+            seconds,
+            clock: match args.budget_clock {
+                BudgetClockArg::Wall => BudgetClock::Wall,
+                BudgetClockArg::Cpu => BudgetClock::Cpu,
+            },
+        }),
         threads: args.threads,
         camera: camera.clone(),
     };
@@ -266,11 +282,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "spp": result.spp,
         "spp_requested": spp,
         "time_budget_s": args.time_budget,
+        "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
         "seed": args.seed,
         "width": width,
         "height": height,
         "camera": camera,
         "threads": args.threads,
+        "worker_threads": result.threads,
         "wall_seconds": result.wall_seconds,
         "cpu_seconds": result.cpu_seconds,
         "rays": { "camera": result.counters.camera_rays, "shadow": result.counters.shadow_rays, "bsdf": result.counters.bsdf_rays },

@@ -101,6 +101,38 @@ fn time_budget_records_the_spp_reached() {
     assert_eq!(meta["time_budget_s"], 0.5);
 }
 
+#[test]
+fn cpu_clock_budget_stops_after_its_cpu_time_per_thread() {
+    let dir = temp_dir("budget-cpu");
+    let out = dir.join("t.exr");
+    let o = manylights(&[
+        "render",
+        SCENE,
+        "--time-budget",
+        "0.3",
+        "--budget-clock",
+        "cpu",
+        "--threads",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("t.json")).unwrap()).unwrap();
+    assert_eq!(meta["budget_clock"], "cpu");
+    assert_eq!(meta["worker_threads"], 1);
+    // No pass starts once 0.3 s of CPU time is spent, so the render used at least that much
+    // (the clock ticks in 10 ms steps) however busy the machine was.
+    assert!(meta["cpu_seconds"].as_f64().unwrap() >= 0.29, "{meta}");
+    assert!(meta["spp"].as_u64().unwrap() >= 2);
+}
+
 /// Runs a command that must fail with one clear line and leave no output file behind.
 fn assert_clean_failure(dir: &Path, args: &[&str], expect: &str) {
     let o = manylights(args);

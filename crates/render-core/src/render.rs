@@ -24,11 +24,29 @@ pub struct RenderSettings {
     /// Samples per pixel; with a time budget, the most that will be taken (`None` = no limit).
     pub spp: Option<u32>,
     pub seed: u64,
-    /// Seconds after which no new pass starts.
-    pub time_budget: Option<f64>,
+    /// No new pass starts once this budget is spent.
+    pub time_budget: Option<TimeBudget>,
     /// Worker threads (`None` = all cores).
     pub threads: Option<usize>,
     pub camera: Camera,
+}
+
+/// A render-time limit, checked between passes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TimeBudget {
+    pub seconds: f64,
+    pub clock: BudgetClock,
+}
+
+/// What a time budget counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BudgetClock {
+    /// Elapsed wall time.
+    Wall,
+    /// The process's CPU time divided by the worker threads: the wall time the render would
+    /// take on otherwise idle cores. Equal-time comparisons stay fair on a shared machine,
+    /// where other jobs would otherwise steal time from some cells and not others.
+    Cpu,
 }
 
 #[derive(Clone, Copy, Default)]
@@ -57,6 +75,8 @@ pub struct RenderResult {
     pub wall_seconds: f64,
     pub cpu_seconds: Option<f64>,
     pub passes: u32,
+    /// Worker threads the passes ran on.
+    pub threads: usize,
 }
 
 impl RenderResult {
@@ -64,6 +84,21 @@ impl RenderResult {
     pub fn unlit_mask(&self) -> Vec<bool> {
         self.light_fraction.iter().map(|&f| f == 0.0).collect()
     }
+}
+
+/// Whether `budget` is used up since `start` (wall) / `cpu_start` (process CPU seconds).
+fn budget_spent(
+    budget: &TimeBudget,
+    start: Instant,
+    cpu_start: Option<f64>,
+    threads: usize,
+) -> bool {
+    let spent = match (budget.clock, cpu_start, process_cpu_seconds()) {
+        (BudgetClock::Cpu, Some(a), Some(b)) => (b - a) / threads.max(1) as f64,
+        // No CPU clock on this platform: fall back to wall time rather than never stopping.
+        _ => start.elapsed().as_secs_f64(),
+    };
+    spent >= budget.seconds
 }
 
 /// Camera-ray shading: emission seen directly plus direct lighting at the hit.
@@ -173,7 +208,7 @@ pub fn render(
         }
         if let Some(budget) = settings.time_budget
             && passes > 0
-            && start.elapsed().as_secs_f64() >= budget
+            && budget_spent(&budget, start, cpu_start, pool.current_num_threads())
         {
             break;
         }
@@ -287,5 +322,6 @@ pub fn render(
         wall_seconds,
         cpu_seconds,
         passes,
+        threads: pool.current_num_threads(),
     })
 }

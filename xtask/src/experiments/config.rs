@@ -6,7 +6,9 @@
 //! height = 96
 //! seeds = [0, 1]             # one cell per seed; several give mean ± std
 //! spp = [4, 16]              # equal-spp cells
-//! time_budgets = [2.0]       # equal-time cells (seconds of wall time, `--time-budget`)
+//! time_budgets = [2.0]       # equal-time cells (seconds, `--time-budget`)
+//! budget_clock = "cpu"       # what a time budget counts: "cpu" (default: process CPU time per
+//!                            # worker thread, fair on a shared machine) or "wall"
 //! baseline = "E&K"           # the column speed-ups are measured against
 //!
 //! [reference]
@@ -43,6 +45,9 @@ pub struct Experiment {
     pub spp: Vec<u32>,
     #[serde(default)]
     pub time_budgets: Vec<f64>,
+    /// What the time budgets count (`manylights render --budget-clock`).
+    #[serde(default)]
+    pub budget_clock: BudgetClock,
     /// Label of the column that speed-ups are relative to (default: the first strategy).
     #[serde(default)]
     pub baseline: Option<String>,
@@ -52,6 +57,25 @@ pub struct Experiment {
     pub reference: ReferenceSpec,
     pub scenes: Vec<SceneEntry>,
     pub strategies: Vec<StrategyEntry>,
+}
+
+/// `cpu`: the render process's CPU seconds divided by its worker threads, so that other jobs on
+/// the machine do not shorten some equal-time cells and not others; `wall`: elapsed time.
+#[derive(Clone, Copy, Debug, Default, Deserialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum BudgetClock {
+    #[default]
+    Cpu,
+    Wall,
+}
+
+impl BudgetClock {
+    pub fn cli_name(self) -> &'static str {
+        match self {
+            BudgetClock::Cpu => "cpu",
+            BudgetClock::Wall => "wall",
+        }
+    }
 }
 
 fn default_seeds() -> Vec<u64> {

@@ -423,6 +423,7 @@ pub fn convergence_plot(
     title: &str,
     vs_spp: &[Series],
     vs_seconds: &[Series],
+    seconds_label: &str,
     floor: Option<f64>,
 ) -> Result<(), String> {
     register_font();
@@ -436,7 +437,7 @@ pub fn convergence_plot(
             .map_err(|e| e.to_string())?;
         let (l, r) = root.split_horizontally(w / 2);
         panel(&l, "equal spp", "samples per pixel", vs_spp, floor)?;
-        panel(&r, "equal time", "wall seconds", vs_seconds, floor)?;
+        panel(&r, "equal time", seconds_label, vs_seconds, floor)?;
         root.present().map_err(|e| e.to_string())?;
     }
     save_png(path, w, h, &buf)
@@ -469,7 +470,7 @@ mod tests {
             label: "A".into(),
             points: vec![(1.0, 0.1, 0.01), (4.0, 0.025, 0.002)],
         }];
-        convergence_plot(&dir.join("p.png"), "t", &s, &s, Some(0.001)).unwrap();
+        convergence_plot(&dir.join("p.png"), "t", &s, &s, "seconds", Some(0.001)).unwrap();
         let (w, h) = (16u32, 8u32);
         let img = vec![Vec3::splat(0.3); (w * h) as usize];
         let unlit = vec![true; (w * h) as usize];

@@ -394,7 +394,12 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
                 None
             }
             Budget::Time(t) => {
-                cmd.extend(["--time-budget".into(), t.to_string()]);
+                cmd.extend([
+                    "--time-budget".into(),
+                    t.to_string(),
+                    "--budget-clock".into(),
+                    cell.budget_clock.cli_name().into(),
+                ]);
                 Some(t)
             }
         };

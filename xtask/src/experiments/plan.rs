@@ -1,6 +1,6 @@
 //! The cells of an experiment: scene × strategy × (spp or time budget) × seed, their ids and
 //! keys, `--only` and `--shard`.
-use super::config::{Experiment, SceneEntry, StrategyEntry};
+use super::config::{BudgetClock, Experiment, SceneEntry, StrategyEntry};
 use serde::{Deserialize, Serialize};
 
 /// 64-bit FNV-1a: a stable (toolchain-independent) hash for cache keys.
@@ -65,6 +65,8 @@ pub struct Cell {
     pub scene_label: String,
     pub strategy: StrategyEntry,
     pub budget: Budget,
+    /// What a time budget counts (unused by spp cells).
+    pub budget_clock: BudgetClock,
     pub seed: u64,
     pub width: u32,
     pub height: u32,
@@ -86,8 +88,13 @@ impl Cell {
     /// a stored cell whose key differs is stale and rendered again.
     pub fn key_material(&self) -> String {
         let args = self.strategy.cli_args().unwrap_or_default().join(" ");
+        // Only time cells depend on the clock, so spp cells stay valid whatever it is.
+        let clock = match self.budget {
+            Budget::Time(_) => format!("|clock={}", self.budget_clock.cli_name()),
+            Budget::Spp(_) => String::new(),
+        };
         format!(
-            "scene={}|camera={:?}|strategy={}|args={}|budget={:?}|seed={}|res={}x{}",
+            "scene={}|camera={:?}|strategy={}|args={}|budget={:?}{clock}|seed={}|res={}x{}",
             self.scene.spec,
             self.scene.camera,
             self.strategy.name,
@@ -153,6 +160,7 @@ pub fn expand(exp: &Experiment) -> Vec<Cell> {
                         scene_label: scene.label(),
                         strategy: strategy.clone(),
                         budget: *budget,
+                        budget_clock: exp.budget_clock,
                         seed,
                         width,
                         height,

@@ -1,4 +1,5 @@
 //! Cell results and what is made of them: cells.csv, cells.json, table.md, plots, strips.
+use super::config::BudgetClock;
 use super::plan::Budget;
 use super::reference::Metric;
 use serde::{Deserialize, Serialize};
@@ -33,6 +34,20 @@ pub struct CellResult {
     pub cpu_seconds: f64,
     /// The render's own JSON (stats, rays, technique samples, parameters, commit).
     pub render: serde_json::Value,
+}
+
+impl CellResult {
+    /// The render's duration on `clock`: wall seconds, or CPU seconds per worker thread (wall
+    /// seconds where the render did not record its CPU time or thread count).
+    pub fn seconds(&self, clock: BudgetClock) -> f64 {
+        let threads = self.render["worker_threads"].as_u64().unwrap_or(0);
+        match clock {
+            BudgetClock::Cpu if threads > 0 && self.cpu_seconds > 0.0 => {
+                self.cpu_seconds / threads as f64
+            }
+            _ => self.wall_seconds,
+        }
+    }
 }
 
 /// Mean and sample standard deviation.
@@ -74,7 +89,7 @@ pub enum Pixels {
     All,
 }
 
-pub fn entry(cells: &[&CellResult], pixels: Pixels) -> Entry {
+pub fn entry(cells: &[&CellResult], pixels: Pixels, clock: BudgetClock) -> Entry {
     let errs: Vec<f64> = cells
         .iter()
         .map(|c| match pixels {
@@ -85,7 +100,7 @@ pub fn entry(cells: &[&CellResult], pixels: Pixels) -> Entry {
     let n = cells.len().max(1) as f64;
     Entry {
         error: Stat::of(&errs),
-        seconds: cells.iter().map(|c| c.wall_seconds).sum::<f64>() / n,
+        seconds: cells.iter().map(|c| c.seconds(clock)).sum::<f64>() / n,
         spp: cells.iter().map(|c| c.spp as f64).sum::<f64>() / n,
     }
 }
