@@ -51,6 +51,10 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Also list the N pixels (among the unlit ones with --mask) that carry the most relMSE,
+        /// with their share of the total: the way to find the fireflies behind an error.
+        #[arg(long, default_value_t = 0)]
+        worst: usize,
     },
 }
 
@@ -68,7 +72,8 @@ fn main() -> ExitCode {
             reference,
             mask,
             json,
-        } => compare(&image, &reference, mask.as_deref(), json),
+            worst,
+        } => compare(&image, &reference, mask.as_deref(), json, worst),
         Command::CapIntegral { method } => cap_integral(&method),
         Command::Strategies => {
             for s in samplers::strategies() {
@@ -154,8 +159,9 @@ fn compare(
     reference: &std::path::Path,
     mask: Option<&std::path::Path>,
     json: bool,
+    worst: usize,
 ) -> anyhow::Result<()> {
-    use render_core::metrics::error_metrics;
+    use render_core::metrics::{error_metrics, rel_mse_map};
     let (w, h, x) = render_core::output::read_exr(image).map_err(anyhow::Error::msg)?;
     let (rw, rh, r) = render_core::output::read_exr(reference).map_err(anyhow::Error::msg)?;
     if (w, h) != (rw, rh) {
@@ -166,15 +172,43 @@ fn compare(
         );
     }
     let all = error_metrics(&x, &r, None);
-    let unlit = match mask {
-        Some(m) => {
-            let unlit = render_core::output::read_mask_png(m, w, h).map_err(anyhow::Error::msg)?;
-            Some(error_metrics(&x, &r, Some(&unlit)))
-        }
+    let unlit_mask = match mask {
+        Some(m) => Some(render_core::output::read_mask_png(m, w, h).map_err(anyhow::Error::msg)?),
         None => None,
     };
+    let unlit = unlit_mask
+        .as_deref()
+        .map(|m| error_metrics(&x, &r, Some(m)));
+    // Pixels by their share of the (masked) error sum, largest first.
+    let map = rel_mse_map(&x, &r);
+    let mut order: Vec<usize> = (0..map.len())
+        .filter(|&i| unlit_mask.as_ref().is_none_or(|m| m[i]))
+        .collect();
+    let total: f64 = order.iter().map(|&i| map[i] as f64).sum();
+    order.sort_by(|&a, &b| map[b].total_cmp(&map[a]).then(a.cmp(&b)));
+    order.truncate(worst);
+    let share = |i: usize| {
+        if total > 0.0 {
+            map[i] as f64 / total
+        } else {
+            0.0
+        }
+    };
+    let width = w as usize;
     if json {
-        println!("{}", serde_json::json!({ "all": all, "unlit": unlit }));
+        let worst_pixels: Vec<serde_json::Value> = order
+            .iter()
+            .map(|&i| {
+                serde_json::json!({
+                    "x": i % width, "y": i / width, "rel_mse": map[i], "share": share(i),
+                    "value": x[i].to_array(), "reference": r[i].to_array(),
+                })
+            })
+            .collect();
+        println!(
+            "{}",
+            serde_json::json!({ "all": all, "unlit": unlit, "worst": worst_pixels })
+        );
     } else {
         println!(
             "all pixels    relMSE {:.6e}  MSE {:.6e}  ({} px)",
@@ -184,6 +218,17 @@ fn compare(
             println!(
                 "unlit pixels  relMSE {:.6e}  MSE {:.6e}  ({} px)",
                 u.rel_mse, u.mse, u.pixels
+            );
+        }
+        for &i in &order {
+            println!(
+                "pixel ({:>4}, {:>4})  relMSE {:.3e}  {:5.1} % of the sum  value {:?}  reference {:?}",
+                i % width,
+                i / width,
+                map[i],
+                100.0 * share(i),
+                x[i].to_array(),
+                r[i].to_array()
             );
         }
     }

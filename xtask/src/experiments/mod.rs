@@ -406,6 +406,8 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
         if let Some(c) = &cell.scene.camera {
             cmd.extend(["--camera".into(), c.clone()]);
         }
+        // The render's own light mask (and the strategy's diagnostic maps) for the unlit metric.
+        cmd.push("--aux".into());
         if let Some(t) = threads {
             cmd.extend(["--threads".into(), t.to_string()]);
         }
@@ -503,8 +505,19 @@ fn measure(
         return Err(format!("render is {w}x{h}, its reference is not"));
     }
     let all = render_core::metrics::error_metrics(&px, &reference.pixels, None).into();
+    // Unlit = neither the reference's camera rays nor this render's saw a light. The reference
+    // alone misses lights that cover a tiny part of a pixel; one camera sample of this render
+    // landing on one adds light-seen-directly noise that no light-sampling strategy changes
+    // (at equal spp and seed every strategy shoots the same camera rays, so the same pixels).
+    let own = render_core::output::read_mask_png(&exr.with_extension("mask.png"), w, h)?;
+    let unlit_pixels: Vec<bool> = reference
+        .unlit
+        .iter()
+        .zip(&own)
+        .map(|(&r, &c)| r && c)
+        .collect();
     let unlit =
-        render_core::metrics::error_metrics(&px, &reference.pixels, Some(&reference.unlit)).into();
+        render_core::metrics::error_metrics(&px, &reference.pixels, Some(&unlit_pixels)).into();
     Ok(CellResult {
         id: cell.id(),
         key,

@@ -94,7 +94,7 @@ impl Cell {
             Budget::Spp(_) => String::new(),
         };
         format!(
-            "scene={}|camera={:?}|strategy={}|args={}|budget={:?}{clock}|seed={}|res={}x{}",
+            "scene={}|camera={:?}|strategy={}|args={}|budget={:?}{clock}|seed={}|res={}x{}|unlit=ref-and-own-mask",
             self.scene.spec,
             self.scene.camera,
             self.strategy.name,

@@ -130,7 +130,7 @@ pub fn generate(
     let _ = writeln!(
         md,
         "Error: relMSE = mean over pixels and channels of (x − r)² / (r² + 0.01) against the reference, \
-         over the pixels whose camera ray sees no light (the reference's mask) unless the table says \"all pixels\"; \
+         over the pixels where no camera ray of the reference or of the render itself sees a light unless the table says \"all pixels\"; \
          mean ± standard deviation over the seeds {:?}. **Bold**: lowest in the row. \
          (n×): speed-up over the baseline `{baseline}`: at equal time the ratio of relMSE, \
          at equal spp the ratio of relMSE × seconds (how much longer the baseline needs for the same error). \
