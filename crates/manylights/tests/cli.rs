@@ -77,15 +77,14 @@ fn exr_bytes_do_not_depend_on_thread_count() {
     );
 }
 
-#[test]
-fn time_budget_records_the_spp_reached() {
-    let dir = temp_dir("budget");
+/// Renders SCENE at 16×16 into `dir/t.exr` with a time budget and `extra` flags; its JSON.
+fn render_with_budget(dir: &Path, seconds: &str, extra: &[&str]) -> serde_json::Value {
     let out = dir.join("t.exr");
-    let o = manylights(&[
+    let mut args = vec![
         "render",
         SCENE,
         "--time-budget",
-        "0.5",
+        seconds,
         "--width",
         "16",
         "--height",
@@ -93,38 +92,27 @@ fn time_budget_records_the_spp_reached() {
         "--quiet",
         "--out",
         out.to_str().unwrap(),
-    ]);
+    ];
+    args.extend_from_slice(extra);
+    let o = manylights(&args);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("t.json")).unwrap()).unwrap();
+    serde_json::from_str(&std::fs::read_to_string(dir.join("t.json")).unwrap()).unwrap()
+}
+
+#[test]
+fn time_budget_records_the_spp_reached() {
+    let meta = render_with_budget(&temp_dir("budget"), "0.5", &[]);
     assert!(meta["spp"].as_u64().unwrap() >= 1);
     assert_eq!(meta["time_budget_s"], 0.5);
 }
 
 #[test]
 fn cpu_clock_budget_stops_after_its_cpu_time_per_thread() {
-    let dir = temp_dir("budget-cpu");
-    let out = dir.join("t.exr");
-    let o = manylights(&[
-        "render",
-        SCENE,
-        "--time-budget",
+    let meta = render_with_budget(
+        &temp_dir("budget-cpu"),
         "0.3",
-        "--budget-clock",
-        "cpu",
-        "--threads",
-        "1",
-        "--width",
-        "16",
-        "--height",
-        "16",
-        "--quiet",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let meta: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("t.json")).unwrap()).unwrap();
+        &["--budget-clock", "cpu", "--threads", "1"],
+    );
     assert_eq!(meta["budget_clock"], "cpu");
     assert_eq!(meta["worker_threads"], 1);
     // No pass starts once 0.3 s of CPU time is spent, so the render used at least that much
@@ -241,6 +229,8 @@ fn compare_reports_error_against_a_reference() {
         "--mask",
         mask.to_str().unwrap(),
         "--json",
+        "--worst",
+        "3",
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
@@ -248,7 +238,24 @@ fn compare_reports_error_against_a_reference() {
         v["all"]["rel_mse"].as_f64().unwrap() > 0.0,
         "independent renders differ"
     );
-    assert!(v["unlit"]["pixels"].as_u64().unwrap() <= v["all"]["pixels"].as_u64().unwrap());
+    let unlit = v["unlit"]["pixels"].as_u64().unwrap();
+    assert!(unlit <= v["all"]["pixels"].as_u64().unwrap());
+    // The worst pixels come largest first, and their shares are those of the unlit error sum:
+    // the relMSE of a pixel is its share × (3 channels' mean → the sum over unlit pixels).
+    let worst = v["worst"].as_array().unwrap();
+    assert_eq!(worst.len(), 3);
+    let e: Vec<f64> = worst
+        .iter()
+        .map(|p| p["rel_mse"].as_f64().unwrap())
+        .collect();
+    assert!(e[0] >= e[1] && e[1] >= e[2], "{e:?}");
+    let total = v["unlit"]["rel_mse"].as_f64().unwrap() * unlit as f64;
+    let share = worst[0]["share"].as_f64().unwrap();
+    assert!(
+        (share * total - e[0]).abs() <= 1e-4 * e[0],
+        "{share} × {total} vs {}",
+        e[0]
+    );
     let o = manylights(&[
         "compare",
         a.to_str().unwrap(),
