@@ -5,8 +5,10 @@ use crate::mis::power2;
 use crate::selection::LightSelection;
 use render_core::Vec3;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
+use render_core::light::LightSample;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
+use render_core::stats::Counters;
 
 pub struct LightStrategy<S: LightSelection> {
     pub name: String,
@@ -17,6 +19,26 @@ pub struct LightStrategy<S: LightSelection> {
 
 pub const TECHNIQUE_LIGHT: usize = 0;
 pub const TECHNIQUE_BSDF: usize = 1;
+
+/// Samples a point on a picked light (`pmf`: its selection probability) and shades it:
+/// `(sample, pmf × point pdf, f·L with visibility)`, or `None` when it contributes nothing.
+pub(crate) fn sample_pick(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    light: u32,
+    pmf: f32,
+    rng: &mut SampleStream,
+    counters: &mut Counters,
+) -> Option<(LightSample, f32, Vec3)> {
+    let u = rng.next_2d();
+    let s = scene.lights[light as usize].sample(sp.point(), u)?;
+    let p = pmf * s.pdf;
+    if !(p > 0.0) {
+        return None;
+    }
+    let f = sp.shade(scene, &s, counters);
+    (f != Vec3::ZERO).then_some((s, p, f))
+}
 
 impl<S: LightSelection> DirectLighting for LightStrategy<S> {
     fn name(&self) -> String {
@@ -48,19 +70,11 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
         let x = sp.point();
         let mut l = Vec3::ZERO;
         for &(light, pmf) in &picks {
-            let u = rng.next_2d();
             ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
-            let Some(s) = scene.lights[light as usize].sample(x, u) else {
+            let Some((s, p_light, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters)
+            else {
                 continue;
             };
-            let p_light = pmf * s.pdf;
-            if !(p_light > 0.0) {
-                continue;
-            }
-            let f = sp.shade(scene, &s, ctx.counters);
-            if f == Vec3::ZERO {
-                continue;
-            }
             let w = if self.with_bsdf && !s.is_delta {
                 power2(p_light, sp.bsdf.pdf(sp.wo, s.wi))
             } else {

@@ -8,6 +8,7 @@ use super::pivot_sphere::PivotSphere;
 use super::technique::BoState;
 use super::{BoConfig, LobePivot};
 use crate::bsdf_sampling::sample_bsdf;
+use crate::light_strategy::sample_pick;
 use crate::mis::power_heuristic;
 use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
@@ -169,18 +170,10 @@ where
         let mut picks = Vec::new();
         self.ls.pick(&ls_state, sp, rng, &mut picks);
         for &(light, pmf) in &picks {
-            let u = rng.next_2d();
             ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
-            let Some(s) = scene.lights[light as usize].sample(x, u) else {
+            let Some((s, p_ls, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters) else {
                 continue;
             };
-            if !(pmf * s.pdf > 0.0) {
-                continue;
-            }
-            let f = sp.shade(scene, &s, ctx.counters);
-            if f == Vec3::ZERO {
-                continue;
-            }
             let mut p = densities(
                 light as usize,
                 s.point,
@@ -193,12 +186,11 @@ where
                 {
                     let replay = self.ls.pmf(&ls_state, sp, light)
                         * scene.lights[light as usize].pdf(x, s.point, s.normal);
-                    let own = pmf * s.pdf;
-                    s.is_delta || (replay - own).abs() <= 1e-3 * own
+                    s.is_delta || (replay - p_ls).abs() <= 1e-3 * p_ls
                 },
                 "LS pdf at sampling vs replay"
             );
-            p[TECHNIQUE_LS] = pmf * s.pdf;
+            p[TECHNIQUE_LS] = p_ls;
             taken.push(Taken {
                 tech: TECHNIQUE_LS,
                 f,
