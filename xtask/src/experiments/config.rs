@@ -118,6 +118,10 @@ pub struct SceneEntry {
     /// baseline's error is largest).
     #[serde(default)]
     pub insets: Vec<[u32; 3]>,
+    /// Reference spp for this scene instead of `[reference] spp` (a scene whose reference
+    /// converges slowly, without making every other scene's reference longer).
+    #[serde(default)]
+    pub reference_spp: Option<u32>,
 }
 
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -244,6 +248,16 @@ fn validate(e: &Experiment) -> Result<(), String> {
     if e.reference.spp < 2 {
         return Err("reference.spp must be at least 2 (it is split into two halves)".into());
     }
+    if let Some(s) = e
+        .scenes
+        .iter()
+        .find(|s| s.reference_spp.is_some_and(|n| n < 2))
+    {
+        return Err(format!(
+            "scene {}: reference_spp must be at least 2 (it is split into two halves)",
+            s.label()
+        ));
+    }
     if e.scenes.is_empty() {
         return Err("no [[scenes]]".into());
     }
@@ -318,6 +332,7 @@ mod tests {
         [[scenes]]
         label = "cornell-real"
         spec = "../shared/scenes/cornell_box/cornell_box.glb"
+        reference_spp = 256
         [[strategies]]
         label = "E&K"
         name = "tree-split+bsdf"
@@ -337,6 +352,10 @@ mod tests {
         assert_eq!(e.reference.seed, 1_000_000);
         assert_eq!(e.scenes[0].label(), "glossy-spheres-lights=64");
         assert_eq!(e.scenes[1].label(), "cornell-real");
+        assert_eq!(
+            (e.scenes[0].reference_spp, e.scenes[1].reference_spp),
+            (None, Some(256))
+        );
         assert_eq!(e.baseline(), "E&K");
         assert_eq!(
             e.strategies[0].cli_args().unwrap(),
@@ -381,6 +400,8 @@ mod tests {
         assert!(err(&neg).contains("positive"));
         let ref1 = GOOD.replace("spp = 64", "spp = 1");
         assert!(err(&ref1).contains("two halves"));
+        let scene_ref1 = GOOD.replace("reference_spp = 256", "reference_spp = 1");
+        assert!(err(&scene_ref1).contains("cornell-real: reference_spp"));
         let table = GOOD.replace("max_cut = 8", "max_cut = [8]");
         assert!(err(&table).contains("max_cut"), "{}", err(&table));
         let typ = GOOD.replace("width = 32", "width = \"wide\"");

@@ -312,7 +312,7 @@ fn run(args: RunArgs) -> Result<ExitCode, String> {
                 camera: s.camera.clone(),
                 strategy: exp.reference.strategy.clone(),
                 args: exp.reference.cli_args()?,
-                spp: exp.reference.spp,
+                spp: s.reference_spp.unwrap_or(exp.reference.spp),
                 seed: exp.reference.seed,
                 width,
                 height,

@@ -134,9 +134,15 @@ pub fn generate(
          mean ± standard deviation over the seeds {:?}. **Bold**: lowest in the row. \
          (n×): speed-up over the baseline `{baseline}`: at equal time the ratio of relMSE, \
          at equal spp the ratio of relMSE × seconds (how much longer the baseline needs for the same error). \
-         *ref. noise*: relMSE between the reference's two independent halves ({} at {} spp in all); \
+         *ref. noise*: relMSE between the reference's two independent halves ({} at {} spp in all{}); \
          the reference's own relMSE is about a quarter of it, and differences below it are not real.\n",
-        exp.seeds, exp.reference.strategy, exp.reference.spp
+        exp.seeds,
+        exp.reference.strategy,
+        exp.reference.spp,
+        exp.scenes
+            .iter()
+            .filter_map(|s| s.reference_spp.map(|n| format!(", {n} for {}", s.label())))
+            .collect::<String>()
     );
     for budget in &budgets {
         let g = grid(&cells, budget, Pixels::Unlit, exp.budget_clock);
