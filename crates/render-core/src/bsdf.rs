@@ -1,11 +1,13 @@
-//! Reflection BSDF at a surface point: Lambert plus a GGX lobe with Schlick Fresnel.
+//! Reflection BSDF at a surface point: Lambert plus a GGX lobe weighted by its Fresnel
+//! ([`Specular`]: glTF's Schlick, or pbrt-v3 `plastic`'s Ks × dielectric Fresnel).
+//! The lobes are added, not coupled.
 //!
 //! Directions are in world space; the BSDF works in the local frame of the shading normal,
 //! flipped to the viewer's side. A direction below the geometric surface (as seen from the
 //! viewer) gets zero: this renderer has no transmission.
 use crate::frame::Frame;
-use crate::material::BsdfParams;
-use crate::microfacet::{Ggx, reflect, schlick};
+use crate::material::{BsdfParams, Specular};
+use crate::microfacet::{Ggx, reflect};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
@@ -50,7 +52,16 @@ impl Bsdf {
 
     /// True when the specular lobe is absent (the paper skips BRDF-oriented sampling there).
     pub fn is_pure_diffuse(&self) -> bool {
-        self.params.f0.max_element() <= 0.0
+        self.params.specular.is_none()
+    }
+
+    /// The glossy lobe's weight where it peaks, in the mirror configuration (half vector =
+    /// normal, so ωi makes θo with it): the Fresnel-weighted colour the lobe reflects with.
+    pub fn glossy_weight(&self, wo_local: Vec3) -> Vec3 {
+        if self.is_pure_diffuse() {
+            return Vec3::ZERO;
+        }
+        self.params.specular.weight(wo_local.z)
     }
 
     pub fn has_diffuse(&self) -> bool {
@@ -58,6 +69,8 @@ impl Bsdf {
     }
 
     /// Probability of choosing the specular lobe when sampling, a fixed function of (wo, params).
+    /// pbrt-v3 picks one of its BxDFs uniformly, so `plastic` takes ½; the glTF lobe follows
+    /// the lobes' weights at ωo.
     pub fn specular_probability(&self, wo_local: Vec3) -> f32 {
         if self.is_pure_diffuse() {
             return 0.0;
@@ -65,7 +78,10 @@ impl Bsdf {
         if !self.has_diffuse() {
             return 1.0;
         }
-        let s = luminance(schlick(self.params.f0, wo_local.z));
+        if let Specular::PbrtPlastic { .. } = self.params.specular {
+            return 0.5;
+        }
+        let s = luminance(self.params.specular.weight(wo_local.z));
         let d = luminance(self.params.diffuse);
         (s / (s + d)).clamp(0.25, 0.9)
     }
@@ -87,7 +103,7 @@ impl Bsdf {
         let mut f = self.params.diffuse * (li.z / PI);
         if !self.is_pure_diffuse() {
             let h = (lo + li).normalize();
-            f += schlick(self.params.f0, li.dot(h)) * self.ggx.eval_cos(lo, li);
+            f += self.params.specular.weight(li.dot(h)) * self.ggx.eval_cos(lo, li);
         }
         f
     }
@@ -147,7 +163,13 @@ mod tests {
     fn bsdf(alpha: f32, diffuse: f32, f0: f32, wo: Vec3) -> Bsdf {
         let params = BsdfParams {
             diffuse: Vec3::splat(diffuse),
-            f0: Vec3::splat(f0),
+            specular: if f0 > 0.0 {
+                Specular::Schlick {
+                    f0: Vec3::splat(f0),
+                }
+            } else {
+                Specular::None
+            },
             alpha,
         };
         Bsdf::new(Vec3::Z, Vec3::Z, wo, params)

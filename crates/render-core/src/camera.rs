@@ -14,6 +14,10 @@ pub struct Camera {
     /// Preferred image size; the command line may override it.
     pub width: u32,
     pub height: u32,
+    /// The image's right is −(forward × up): a camera whose frame is left-handed in world
+    /// space, as pbrt's `LookAt` makes for a right-handed scene.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub mirrored: bool,
 }
 
 impl Camera {
@@ -36,6 +40,7 @@ impl Camera {
             yfov,
             width,
             height,
+            mirrored: false,
         }
     }
 
@@ -57,10 +62,16 @@ impl Camera {
         )
     }
 
+    /// World direction of the image's +x.
+    pub fn right(&self) -> Vec3 {
+        let r = self.forward.cross(self.up);
+        if self.mirrored { -r } else { r }
+    }
+
     /// World ray through film position `film` in [0,1]² (x right, y down) for an image of the given aspect.
     pub fn ray_direction(&self, film: Vec2, aspect: f32) -> Vec3 {
         let tan = (0.5 * self.yfov).tan();
-        let right = self.forward.cross(self.up);
+        let right = self.right();
         let sx = (2.0 * film.x - 1.0) * tan * aspect;
         let sy = (1.0 - 2.0 * film.y) * tan;
         (self.forward + right * sx + self.up * sy).normalize()

@@ -7,6 +7,13 @@ pub enum SceneError {
     Io { path: String, message: String },
     #[error("malformed glTF {path}: {message}")]
     Gltf { path: String, message: String },
+    /// A pbrt scene file: where and what. `line` 0 means the file as a whole.
+    #[error("{path}:{line}: {message}")]
+    Pbrt {
+        path: String,
+        line: usize,
+        message: String,
+    },
     #[error("malformed scene composition {path}: {message}")]
     Composition { path: String, message: String },
     #[error("scene has no triangles and no lights")]

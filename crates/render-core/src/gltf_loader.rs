@@ -7,9 +7,12 @@
 //!   points and lines are skipped and counted in [`SceneStats`](crate::scene::SceneStats);
 //! - metallic-roughness materials: baseColor factor × texture (sRGB decoded), metallic and
 //!   roughness factors × texture (linear, G = roughness, B = metallic), `KHR_materials_specular`
-//!   specularFactor (1 when absent), doubleSided, and emission = emissiveFactor ×
-//!   `KHR_materials_emissive_strength` × emissiveTexture (sRGB decoded). The [`SceneBuilder`]
-//!   turns emissive triangles into area lights (zero-average ones are not lights);
+//!   specularFactor (1 when absent; 0 makes the material pure Lambert), doubleSided, and
+//!   emission = emissiveFactor × `KHR_materials_emissive_strength` × emissiveTexture (sRGB
+//!   decoded). The [`SceneBuilder`] turns emissive triangles into area lights (zero-average ones
+//!   are not lights);
+//! - a material's `extras.pbrt` (its pbrt description, as `manylights convert` and the
+//!   bisml_cornell scene write it) replaces the reflection model: see [`crate::pbrt_extras`];
 //! - `KHR_lights_punctual`: see [`PunctualUnits`] below for the unit convention;
 //! - perspective cameras (`yfov`, `aspectRatio`), looking down the node's −Z with +Y up.
 //!
@@ -461,7 +464,7 @@ impl Loader<'_> {
                         "material `{name}`: specular texture and colour ignored (factor used)"
                     ));
                 }
-                Material {
+                let gltf_material = Material {
                     name,
                     base_color: Vec3::new(bc[0], bc[1], bc[2]),
                     base_color_texture,
@@ -472,6 +475,14 @@ impl Loader<'_> {
                     double_sided: m.double_sided(),
                     emission,
                     emission_texture,
+                    model: Default::default(),
+                };
+                match crate::pbrt_extras::material(gltf_material, m.extras()) {
+                    Ok(mat) => mat,
+                    Err((mat, warning)) => {
+                        self.report.warn(warning);
+                        mat
+                    }
                 }
             }
         };
@@ -1136,6 +1147,79 @@ mod tests {
             let e = err(load_gltf(p, None));
             eprintln!("{e}");
             assert!(!e.to_string().contains('\n'), "{e}");
+        }
+    }
+
+    /// `extras.pbrt` replaces the reflection model: matte → pure Lambert, plastic → pbrt-v3
+    /// plastic, KHR_materials_specular factor 0 → pure Lambert, an unknown type or a bad value
+    /// → a warning and the glTF material.
+    #[test]
+    fn extras_pbrt_materials_load_as_described() {
+        use crate::material::{Model, Specular};
+        let (mut doc, bin) = triangle_doc(TRI);
+        let materials = [
+            json!({ "name": "wall", "pbrMetallicRoughness": { "baseColorFactor": [0.1, 0.1, 0.1, 1] },
+                    "extras": { "pbrt": { "type": "matte", "Kd": [0.725, 0.71, 0.68] } } }),
+            json!({ "name": "bunny", "pbrMetallicRoughness": { "roughnessFactor": 0.0894427 },
+                    "extras": { "pbrt": { "type": "plastic", "Kd": [0.3, 0.1, 0.2], "Ks": [0.7, 0.7, 0.7],
+                                          "roughness": 0.008, "remaproughness": false } } }),
+            json!({ "name": "remapped", "extras": { "pbrt": { "type": "plastic", "roughness": 0.1 } } }),
+            json!({ "name": "no-spec", "pbrMetallicRoughness": { "metallicFactor": 0.0 }, "extensions": { "KHR_materials_specular": { "specularFactor": 0.0 } } }),
+            json!({ "name": "glass", "pbrMetallicRoughness": { "baseColorFactor": [0.5, 0.5, 0.5, 1] },
+                    "extras": { "pbrt": { "type": "glass" } } }),
+            json!({ "name": "bad", "extras": { "pbrt": { "type": "plastic", "Ks": "shiny" } } }),
+            json!({ "name": "plain" }),
+        ];
+        let prim =
+            |m: usize| json!({ "attributes": { "POSITION": 0 }, "indices": 1, "material": m });
+        doc["materials"] = Value::Array(materials.to_vec());
+        doc["meshes"] =
+            json!([{ "primitives": (0..materials.len()).map(prim).collect::<Vec<_>>() }]);
+        let path = write_gltf("extras_pbrt.gltf", doc, &bin);
+        let (scene, report) = load_gltf_with_report(&path, None).unwrap();
+        let m = |name: &str| scene.materials.iter().find(|m| m.name == name).unwrap();
+        let params = |name: &str| m(name).params_at(Vec2::ZERO);
+
+        let wall = params("wall");
+        assert_eq!(wall.specular, Specular::None);
+        assert_eq!(wall.diffuse, Vec3::new(0.725, 0.71, 0.68));
+
+        let bunny = params("bunny");
+        assert_eq!(
+            bunny.specular,
+            Specular::PbrtPlastic {
+                ks: Vec3::splat(0.7)
+            }
+        );
+        assert_eq!(bunny.diffuse, Vec3::new(0.3, 0.1, 0.2));
+        assert!(
+            (bunny.alpha - 0.008).abs() < 1e-7,
+            "α = roughness without remapping"
+        );
+
+        // pbrt-v3's defaults: Kd = Ks = 0.25, remapped roughness
+        let Model::PbrtPlastic { ks, alpha } = m("remapped").model else {
+            panic!("plastic")
+        };
+        assert_eq!(
+            (ks, m("remapped").base_color),
+            (Vec3::splat(0.25), Vec3::splat(0.25))
+        );
+        assert!((alpha - crate::plastic::roughness_to_alpha(0.1)).abs() < 1e-7);
+
+        assert_eq!(params("no-spec").specular, Specular::None);
+        assert!(matches!(params("plain").specular, Specular::Schlick { .. }));
+        for name in ["glass", "bad"] {
+            assert_eq!(m(name).model, Model::MetallicRoughness, "{name}");
+            assert!(matches!(params(name).specular, Specular::Schlick { .. }));
+            assert!(
+                report
+                    .warnings
+                    .iter()
+                    .any(|w| w.contains(&format!("`{name}`")) && w.contains("extras.pbrt")),
+                "{name}: {:?}",
+                report.warnings
+            );
         }
     }
 

@@ -88,12 +88,6 @@ impl Ggx {
     }
 }
 
-/// Schlick's Fresnel approximation.
-pub fn schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
-    let m = (1.0 - cos_theta.clamp(0.0, 1.0)).powi(5);
-    f0 + (Vec3::ONE - f0) * m
-}
-
 pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {
     2.0 * w.dot(n) * n - w
 }

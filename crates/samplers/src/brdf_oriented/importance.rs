@@ -28,8 +28,14 @@ pub struct BoRecord<L> {
     pub frame: Frame,
     /// The glossy lobe's cap integral (SPTD or LTC), un-Fresnelled, without Ks.
     pub lobe: L,
-    /// Luminance of the specular and diffuse albedos.
+    /// Luminance of the glossy lobe's weight, which multiplies its cap integral: by default the
+    /// lobe's actual weight at its peak (Ks·F for pbrt's plastic, Schlick's F for the glTF
+    /// lobe, both at θo: [`render_core::bsdf::Bsdf::glossy_weight`]); in `reproduce` the
+    /// Fresnel-free lobe colour, as the authors' `PrepareForLTC` reports R.y (method.md §1.2:
+    /// "Fresnel is ignored"; Ks = 0.7 on their plastic). Without a diffuse term a constant
+    /// weight cancels from I_BO's distribution anyway; it matters beside `kd`.
     pub ks: f32,
+    /// Luminance of the diffuse albedo.
     pub kd: f32,
     /// Add the diffuse term Kd/π × projected solid angle (our default; off in `reproduce`).
     pub diffuse_term: bool,
@@ -81,6 +87,11 @@ impl LobeDensity for brdf_integrals::LtcLobe {
 impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
     pub fn new(sp: &ShadingPoint, lobe: L, diffuse_term: bool, oat_sander: bool) -> Self {
         let p = &sp.bsdf.params;
+        let weight = if diffuse_term {
+            sp.bsdf.glossy_weight(sp.bsdf.frame.to_local(sp.wo))
+        } else {
+            p.specular.tint()
+        };
         BoRecord {
             point_approx: !oat_sander,
             x: sp.point(),
@@ -89,7 +100,7 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
             ks: if sp.bsdf.is_pure_diffuse() {
                 0.0
             } else {
-                luminance(p.f0).max(0.0)
+                luminance(weight).max(0.0)
             },
             kd: luminance(p.diffuse).max(0.0),
             diffuse_term,
