@@ -1,6 +1,6 @@
 //! `cargo xtask contact-sheet`: one labelled PNG of every scene, rendered with the paper's method
 //! (`mis3-adaptive`, unbiased default mode), into results/scenes/.
-use crate::experiments::images::{Canvas, auto_exposure, tonemap};
+use crate::experiments::compositing::{Canvas, auto_exposure, tonemap};
 use crate::experiments::manylights::{Manylights, repo_root};
 use std::path::Path;
 use std::process::{Command, ExitCode};

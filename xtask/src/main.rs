@@ -1,13 +1,14 @@
 //! Project automation (the `cargo xtask` pattern). Subcommands are added by the issues that need them.
 mod contact_sheet;
 mod experiments;
+mod glossy_mask;
 
 fn main() -> std::process::ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  glossy-mask SCENE W H OUT.png [--max-alpha A]    mask of the pixels whose camera ray sees GGX α < A"
             );
         }
         Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
@@ -18,16 +19,7 @@ fn main() -> std::process::ExitCode {
                 cmd
             };
             let status = std::process::Command::new(env!("CARGO"))
-                .args([
-                    "run",
-                    "--release",
-                    "-p",
-                    "brdf-integrals",
-                    "--bin",
-                    "brdf-tool",
-                    "--",
-                    sub,
-                ])
+                .args(["run", "--release", "-p", "brdf-tool", "--", sub])
                 .args(&args[1..])
                 .status()
                 .expect("failed to run cargo");
@@ -37,6 +29,7 @@ fn main() -> std::process::ExitCode {
         Some("run-experiments" | "merge-results") => return experiments::main(&args),
         // issue 7: every scene on one sheet
         Some("contact-sheet") => return contact_sheet::main(&args),
+        Some("glossy-mask") => return glossy_mask::main(&args),
         Some(other) => {
             eprintln!("error: unknown xtask command `{other}` (try `cargo xtask help`)");
             std::process::exit(2);

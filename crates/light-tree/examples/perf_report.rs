@@ -9,13 +9,9 @@ use std::f32::consts::{FRAC_PI_2, PI};
 use std::hint::black_box;
 use std::time::Instant;
 
-/// utime + stime of this process (clock ticks at 100 Hz) from /proc/self/stat.
+/// CPU time (user + system) of this process; 0 where the platform has no CPU clock.
 fn cpu_seconds() -> f64 {
-    let s = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let rest = s.rsplit(')').next().unwrap_or("");
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let t = |i: usize| f.get(i).and_then(|v| v.parse::<f64>().ok()).unwrap_or(0.0);
-    (t(11) + t(12)) / 100.0
+    host::process_cpu_seconds().unwrap_or(0.0)
 }
 
 fn rand_dir(rng: &mut impl Rng) -> Vec3 {

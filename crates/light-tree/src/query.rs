@@ -360,22 +360,9 @@ impl LightTree {
     /// node is replaced by its two children when `should_split(node)` holds and the cut has
     /// fewer than `max_size` nodes. Leaves are never split. The result is sorted by DFS id
     /// and has at most `max(max_size, 1)` nodes.
-    pub fn cut<S: FnMut(NodeId) -> bool>(&self, max_size: usize, should_split: S) -> Cut {
+    pub fn cut<S: FnMut(NodeId) -> bool>(&self, max_size: usize, mut should_split: S) -> Cut {
         let mut out = Cut::default();
-        self.cut_into(&mut out, &mut VecDeque::new(), max_size, should_split);
-        out
-    }
-
-    /// [`LightTree::cut`] reusing the caller's buffers (`queue` is scratch).
-    pub fn cut_into<S: FnMut(NodeId) -> bool>(
-        &self,
-        out: &mut Cut,
-        queue: &mut VecDeque<NodeId>,
-        max_size: usize,
-        mut should_split: S,
-    ) {
-        out.nodes.clear();
-        queue.clear();
+        let mut queue = VecDeque::new();
         queue.push_back(self.root());
         let mut size = 1usize;
         while let Some(id) = queue.pop_front() {
@@ -389,6 +376,7 @@ impl LightTree {
             }
         }
         out.nodes.sort_unstable();
+        out
     }
 
     /// E&K adaptive cut for a receiver at (`x`, `n`): split a node when `x` lies inside its

@@ -77,16 +77,7 @@ fn main() -> ExitCode {
         Command::CapIntegral { method } => cap_integral(&method),
         Command::Strategies => {
             for s in samplers::strategies() {
-                println!(
-                    "{:<18} {}{}",
-                    s.name,
-                    s.description,
-                    if s.implemented {
-                        ""
-                    } else {
-                        " [not implemented yet]"
-                    }
-                );
+                println!("{:<18} {}", s.name, s.description);
             }
             Ok(())
         }

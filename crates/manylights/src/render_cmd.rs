@@ -5,6 +5,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use render_core::output::{write_exr, write_json, write_mask_png, write_png};
 use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
 use samplers::StrategyOptions;
+use samplers::brdf_oriented::BrdfIntegral;
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -61,21 +62,23 @@ pub struct RenderArgs {
     pub quiet: bool,
 }
 
-/// Knobs of the light-tree and Liu et al. 2019 strategies (defaults: the authors' values).
+/// Knobs of the light-tree and Liu et al. 2019 strategies; their defaults are
+/// [`StrategyOptions::default`] (the authors' values).
 #[derive(Args, Debug, Clone)]
 pub struct MethodArgs {
     /// BRDF-oriented cut: split a node whose cap integral of the glossy lobe exceeds δ.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = StrategyOptions::default().delta)]
     pub delta: f32,
     /// Most BRDF-aware samples beyond the forced two (N = floor(N_max·UB)).
-    #[arg(long, default_value_t = 50)]
+    #[arg(long, default_value_t = StrategyOptions::default().n_max)]
     pub n_max: u32,
     /// Weight of a BRDF-sampling hit in P(BO) = n_nohit / (n_nohit + λ·n_hit).
-    #[arg(long, default_value_t = 10.0)]
+    #[arg(long, default_value_t = StrategyOptions::default().lambda)]
     pub lambda: f32,
     /// Cap-integral approximation behind BRDF-oriented sampling.
-    #[arg(long, value_enum, default_value = "sptd")]
-    pub brdf_integral: BrdfIntegralArg,
+    #[arg(long, default_value_t = StrategyOptions::default().brdf_integral,
+          value_parser = brdf_integral_parser())]
+    pub brdf_integral: BrdfIntegral,
     /// The authors' code's behaviour: nearest SPTD lookup, Oat–Sander cap ∩ cap, glossy-only
     /// importance, one rescaled random number per descent, in-sample (biased) allocation.
     #[arg(long)]
@@ -97,10 +100,10 @@ pub enum BudgetClockArg {
     Cpu,
 }
 
-#[derive(clap::ValueEnum, Clone, Copy, Debug)]
-pub enum BrdfIntegralArg {
-    Sptd,
-    Ltc,
+/// `--brdf-integral`: the names of [`BrdfIntegral`], listed in `--help`.
+fn brdf_integral_parser() -> impl clap::builder::TypedValueParser<Value = BrdfIntegral> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(BrdfIntegral::ALL.map(BrdfIntegral::name)).try_map(|s| s.parse())
 }
 
 impl MethodArgs {
@@ -111,10 +114,7 @@ impl MethodArgs {
             delta: self.delta,
             n_max: self.n_max,
             lambda: self.lambda,
-            brdf_integral: match self.brdf_integral {
-                BrdfIntegralArg::Sptd => samplers::brdf_oriented::BrdfIntegral::Sptd,
-                BrdfIntegralArg::Ltc => samplers::brdf_oriented::BrdfIntegral::Ltc,
-            },
+            brdf_integral: self.brdf_integral,
             reproduce: self.reproduce,
             pivot_sphere: self.pivot_sphere,
             adaptive_total: !self.no_adaptive_total,
@@ -201,6 +201,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if width == 0 || height == 0 {
         bail!("--width and --height must be positive");
     }
+    render_core::render::check_memory(width, height, strategy.aux_channels().len())
+        .map_err(anyhow::Error::msg)?;
     camera.width = width;
     camera.height = height;
     let spp = match (args.spp, args.time_budget) {

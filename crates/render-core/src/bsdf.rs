@@ -5,6 +5,7 @@
 //! Directions are in world space; the BSDF works in the local frame of the shading normal,
 //! flipped to the viewer's side. A direction below the geometric surface (as seen from the
 //! viewer) gets zero: this renderer has no transmission.
+use crate::colour::luminance;
 use crate::frame::Frame;
 use crate::material::{BsdfParams, Specular};
 use crate::microfacet::{Ggx, reflect};
@@ -28,10 +29,6 @@ pub struct BsdfSample {
     pub f_cos: Vec3,
     /// Solid-angle density of `wi`.
     pub pdf: f32,
-}
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 impl Bsdf {
@@ -157,8 +154,8 @@ impl Bsdf {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::{chi2_directions, sidak_significance};
     use crate::rng::SampleStream;
+    use chi2_test::{chi2_directions, sidak_significance};
 
     fn bsdf(alpha: f32, diffuse: f32, f0: f32, wo: Vec3) -> Bsdf {
         let params = BsdfParams {

@@ -296,9 +296,7 @@ fn add_lights(b: &mut SceneBuilder, l: &LightLayout) -> Result<(), SceneError> {
     let c = Vec3::from(l.center);
     let e = Vec3::from(l.extent);
     let per_light = l.power / l.count as f32;
-    let lum = Vec3::from(l.color)
-        .dot(Vec3::new(0.2126, 0.7152, 0.0722))
-        .max(1e-6);
+    let lum = crate::colour::luminance(Vec3::from(l.color)).max(1e-6);
     let color = Vec3::from(l.color) / lum;
     let side = (l.count as f32).sqrt().ceil() as usize;
     let quad_material = if l.shape == Shape::Quad {

@@ -12,6 +12,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod builtin;
 pub mod camera;
+pub mod colour;
 pub mod composition;
 pub mod error;
 pub mod estimator;
@@ -32,8 +33,6 @@ pub mod scene;
 pub mod stats;
 pub mod texture;
 
-/// The workspace chi-square testing helpers, re-exported for the tests of the strategies.
-pub use chi2_test as chi2;
 pub use error::SceneError;
 pub use glam::{Vec2, Vec3};
 

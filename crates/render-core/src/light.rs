@@ -2,6 +2,7 @@
 //! Each can sample a point as seen from a shading point and evaluate the solid-angle density
 //! of any point on it, so every technique can weight any other by MIS.
 //! Distant (directional) lights have no extent and live apart in [`DistantLight`].
+use crate::colour::luminance;
 use crate::frame::Frame;
 use crate::sampling;
 use crate::texture::Texture;
@@ -77,10 +78,6 @@ pub struct LightSample {
     /// Solid-angle density of `wi` (1 for delta lights).
     pub pdf: f32,
     pub is_delta: bool,
-}
-
-pub fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
 }
 
 impl Light {
@@ -276,8 +273,8 @@ pub struct DistantLight {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::chi2::{chi2_directions, sidak_significance};
     use crate::rng::SampleStream;
+    use chi2_test::{chi2_directions, sidak_significance};
 
     fn sphere(center: Vec3, radius: f32) -> Light {
         Light {

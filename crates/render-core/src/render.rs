@@ -9,8 +9,9 @@ use crate::camera::Camera;
 use crate::estimator::{DirectLighting, MAX_AUX, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use crate::rng::SampleStream;
 use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
-use crate::stats::{Counters, process_cpu_seconds};
+use crate::stats::Counters;
 use glam::{Vec2, Vec3};
+use host::process_cpu_seconds;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -58,6 +59,33 @@ struct PixelAccum {
     memory: [f32; PIXEL_MEMORY],
 }
 
+/// Bytes a render of `width` × `height` pixels holds at its peak: the per-pixel accumulators,
+/// then the finished image, its variance, light mask and `aux_channels` maps, and an output
+/// image being encoded (EXR or PNG).
+pub fn memory_estimate(width: u32, height: u32, aux_channels: usize) -> u64 {
+    let finished = 3 * size_of::<Vec3>() + size_of::<f32>() * (1 + aux_channels);
+    let per_pixel = size_of::<PixelAccum>() + finished;
+    width as u64 * height as u64 * per_pixel as u64
+}
+
+/// Refuses, before anything is allocated, a render that needs more memory than the machine
+/// has (where the platform says how much it has).
+pub fn check_memory(width: u32, height: u32, aux_channels: usize) -> Result<(), String> {
+    let need = memory_estimate(width, height, aux_channels);
+    match host::physical_memory_bytes() {
+        Some(have) if need > have => Err(format!(
+            "a {width}×{height} render needs about {:.1} GiB ({} bytes per pixel), more than \
+             this machine's {:.1} GiB of memory",
+            need as f64 / GIB,
+            need / (width as u64 * height as u64),
+            have as f64 / GIB
+        )),
+        _ => Ok(()),
+    }
+}
+
+const GIB: f64 = (1u64 << 30) as f64;
+
 /// The finished image with its diagnostics.
 pub struct RenderResult {
     pub width: u32,
@@ -93,8 +121,8 @@ fn budget_spent(
     cpu_start: Option<f64>,
     threads: usize,
 ) -> bool {
-    // Reads /proc only for the CPU clock; without one (not Linux) wall time stands in rather
-    // than never stopping.
+    // Reads the CPU clock only when the budget counts it; without one (not a Unix) wall time
+    // stands in rather than never stopping.
     let cpu_spent = || Some((process_cpu_seconds()? - cpu_start?) / threads.max(1) as f64);
     let spent = match budget.clock {
         BudgetClock::Cpu => cpu_spent().unwrap_or_else(|| start.elapsed().as_secs_f64()),
@@ -189,6 +217,11 @@ pub fn render(
     if settings.spp.is_none() && settings.time_budget.is_none() {
         return Err("give spp, a time budget, or both".into());
     }
+    check_memory(
+        settings.width,
+        settings.height,
+        strategy.aux_channels().len(),
+    )?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads.unwrap_or(0))
         .build()

@@ -7,7 +7,6 @@ use crate::light::{DistantLight, Light, LightShape, SpotCone};
 use crate::material::Material;
 use glam::{Mat4, Vec2, Vec3};
 use serde::Serialize;
-use std::sync::Arc;
 
 pub const NO_LIGHT: u32 = u32::MAX;
 
@@ -499,6 +498,3 @@ impl SceneBuilder {
         })
     }
 }
-
-/// Shared handle: scenes are immutable once built.
-pub type SceneRef = Arc<Scene>;

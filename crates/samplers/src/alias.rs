@@ -72,7 +72,7 @@ impl AliasTable {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use render_core::chi2::{chi2_test, sidak_significance};
+    use chi2_test::{chi2_test, sidak_significance};
     use render_core::rng::SampleStream;
 
     #[test]

@@ -1,11 +1,7 @@
 //! Statistical comparison of renders, used by the tests that check every strategy converges
 //! to the same image: region means must agree within a number of standard errors.
-use render_core::Vec3;
+use render_core::colour::{LUMINANCE_WEIGHTS, luminance};
 use render_core::render::RenderResult;
-
-fn luminance(c: Vec3) -> f64 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722)) as f64
-}
 
 /// Mean luminance over a pixel rectangle and the standard error of that mean, from the
 /// per-pixel variances of the render. Pixels whose camera ray sees a light are left out
@@ -39,12 +35,12 @@ pub fn region_mean_excluding(
             if excluded(i) {
                 continue;
             }
-            sum += luminance(r.pixels[i]);
+            sum += luminance(r.pixels[i]) as f64;
             let v = r.variance_of_mean[i];
             // Var of a weighted sum of channels, assuming channels perfectly correlated (conservative).
-            let sd = 0.2126 * (v.x as f64).sqrt()
-                + 0.7152 * (v.y as f64).sqrt()
-                + 0.0722 * (v.z as f64).sqrt();
+            let sd = LUMINANCE_WEIGHTS
+                .as_dvec3()
+                .dot(v.as_dvec3().map(f64::sqrt));
             var += sd * sd;
             n += 1;
         }

@@ -71,8 +71,6 @@ impl Default for StrategyOptions {
 pub enum StrategyError {
     #[error("unknown strategy `{name}` (known: {known})")]
     Unknown { name: String, known: String },
-    #[error("strategy `{0}` is not implemented yet")]
-    NotImplemented(String),
     #[error("bad strategy option: {0}")]
     BadOption(String),
 }
@@ -81,62 +79,48 @@ pub enum StrategyError {
 pub struct StrategyInfo {
     pub name: &'static str,
     pub description: &'static str,
-    pub implemented: bool,
 }
 
 pub fn strategies() -> Vec<StrategyInfo> {
-    let s = |name, description, implemented| StrategyInfo {
-        name,
-        description,
-        implemented,
-    };
+    let s = |name, description| StrategyInfo { name, description };
     vec![
         s(
             "uniform",
             "one light chosen uniformly, sampled by its shape",
-            true,
         ),
         s(
             "power",
             "one light chosen by power (alias table), sampled by its shape",
-            true,
         ),
-        s("bsdf", "BSDF sampling only (misses delta lights)", true),
+        s("bsdf", "BSDF sampling only (misses delta lights)"),
         s(
             "power+bsdf",
             "power light sampling and BSDF sampling, power-heuristic MIS",
-            true,
         ),
         s(
             "tree",
             "light tree, single descent (Conty Estevez & Kulla 2018)",
-            true,
         ),
-        s("tree-split", "light tree with adaptive splitting", true),
+        s("tree-split", "light tree with adaptive splitting"),
         s(
             "tree+bsdf",
             "light tree single descent + BSDF sampling, MIS",
-            true,
         ),
         s(
             "tree-split+bsdf",
             "adaptive tree splitting + BSDF sampling, MIS (the paper's E&K baseline)",
-            true,
         ),
         s(
             "brdf-oriented",
             "BRDF-oriented light sampling alone (not complete: see docs)",
-            true,
         ),
         s(
             "mis3-equal",
             "tree splitting + BRDF-oriented + BSDF sampling, equal counts",
-            true,
         ),
         s(
             "mis3-adaptive",
             "Liu et al. 2019: three-technique MIS with adaptive allocation",
-            true,
         ),
     ]
 }
@@ -205,13 +189,13 @@ pub fn create(
         "bsdf" => Box::new(BsdfStrategy),
         "brdf-oriented" | "mis3-equal" | "mis3-adaptive" => mis3(name, scene, opts)?,
         other => {
-            let all = strategies();
-            return Err(match all.iter().find(|s| s.name == other) {
-                Some(_) => StrategyError::NotImplemented(other.into()),
-                None => StrategyError::Unknown {
-                    name: other.into(),
-                    known: all.iter().map(|s| s.name).collect::<Vec<_>>().join(", "),
-                },
+            return Err(StrategyError::Unknown {
+                name: other.into(),
+                known: strategies()
+                    .iter()
+                    .map(|s| s.name)
+                    .collect::<Vec<_>>()
+                    .join(", "),
             });
         }
     })

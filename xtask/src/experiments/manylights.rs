@@ -40,10 +40,7 @@ pub fn classify(stderr: &str) -> Failure {
         .trim()
         .to_string();
     let lower = stderr.to_lowercase();
-    if lower.contains("not implemented yet")
-        || lower.contains("unknown built-in scene")
-        || lower.contains("unknown builtin")
-    {
+    if lower.contains("unknown built-in scene") || lower.contains("unknown builtin") {
         Failure::Skip(last)
     } else if lower.contains("no such file or directory") {
         Failure::Skip(format!("a file is absent: {last}"))
@@ -118,8 +115,8 @@ impl Manylights {
         }
     }
 
-    /// (name, implemented) of every strategy `manylights strategies` lists.
-    pub fn strategies(&self) -> Result<Vec<(String, bool)>, String> {
+    /// The name of every strategy `manylights strategies` lists.
+    pub fn strategies(&self) -> Result<Vec<String>, String> {
         let text = self.output(&["strategies"]).map_err(|e| e.to_string())?;
         Ok(parse_strategies(&text))
     }
@@ -192,12 +189,9 @@ impl Manylights {
     }
 }
 
-pub fn parse_strategies(text: &str) -> Vec<(String, bool)> {
+pub fn parse_strategies(text: &str) -> Vec<String> {
     text.lines()
-        .filter_map(|l| {
-            let name = l.split_whitespace().next()?;
-            Some((name.to_string(), !l.contains("[not implemented yet]")))
-        })
+        .filter_map(|l| Some(l.split_whitespace().next()?.to_string()))
         .collect()
 }
 
@@ -222,23 +216,13 @@ mod tests {
     #[test]
     fn strategies_list() {
         let s = parse_strategies(
-            "tree-split+bsdf    adaptive splitting\nmis3-adaptive      Liu et al. [not implemented yet]\n",
+            "tree-split+bsdf    adaptive splitting\nmis3-adaptive      Liu et al.\n",
         );
-        assert_eq!(
-            s,
-            vec![
-                ("tree-split+bsdf".to_string(), true),
-                ("mis3-adaptive".to_string(), false)
-            ]
-        );
+        assert_eq!(s, vec!["tree-split+bsdf", "mis3-adaptive"]);
     }
 
     #[test]
     fn failures_are_classified() {
-        assert!(matches!(
-            classify("error: strategy `mis3-equal` is not implemented yet\n"),
-            Failure::Skip(_)
-        ));
         assert!(matches!(
             classify("error: unknown built-in scene `car` (known: a, b)"),
             Failure::Skip(_)

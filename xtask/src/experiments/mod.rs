@@ -1,22 +1,22 @@
 //! `cargo xtask run-experiments` and `cargo xtask merge-results`: scenes × strategies × spp /
 //! time budgets × seeds against cached high-spp references; tables, plots and strips in
 //! `results/<experiment>/`. See xtask/README.md.
+pub mod charts;
+pub mod compositing;
 pub mod config;
-pub mod images;
 pub mod manylights;
 pub mod plan;
 pub mod reference;
 pub mod report;
+pub mod run;
 pub mod summary;
 
 use clap::Parser;
 use config::Experiment;
-use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
-use manylights::{Failure, Manylights, repo_root};
-use plan::{Budget, Cell, Shard, hex_hash};
-use reference::{Ensure, Identity, Reference, Validity};
+use indicatif::MultiProgress;
+use manylights::repo_root;
+use plan::{Cell, Shard, hex_hash};
 use report::CellResult;
-use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -123,7 +123,7 @@ pub fn references_dir() -> PathBuf {
 pub fn main(args: &[String]) -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("run-experiments") => match RunArgs::try_parse_from(args) {
-            Ok(a) => run(a),
+            Ok(a) => run::run(a),
             Err(e) => e.exit(),
         },
         Some("merge-results") => match MergeArgs::try_parse_from(args) {
@@ -191,360 +191,6 @@ pub fn say(multi: &MultiProgress, msg: String) -> std::io::Result<()> {
     } else {
         multi.println(msg)
     }
-}
-
-fn style(template: &str) -> ProgressStyle {
-    ProgressStyle::with_template(template).unwrap_or(ProgressStyle::default_bar())
-}
-
-fn run(args: RunArgs) -> Result<ExitCode, String> {
-    if args.list {
-        return list();
-    }
-    let exp = load_experiment(&args.experiment)?;
-    let out = results_dir(&exp, &args.results);
-    let root = repo_root();
-    let threads = args.threads.or(exp.threads);
-
-    let mut cells = plan::expand(&exp);
-    if !args.only.is_empty() {
-        cells.retain(|c| args.only.iter().any(|p| c.matches(p)));
-    }
-    if let Some(shard) = args.shard {
-        cells = shard.select(cells);
-    }
-    if args.dry_run {
-        for c in &cells {
-            println!("{}", c.id());
-        }
-        println!("{} cells", cells.len());
-        return Ok(ExitCode::SUCCESS);
-    }
-
-    let start = Instant::now();
-    let ml = Manylights::build()?;
-    let version = ml.version();
-    let mut notices: Vec<Notice> = Vec::new();
-
-    // strategies that do not exist yet
-    let known = ml.strategies()?;
-    let help = ml.render_help();
-    let mut skip_strategy: BTreeSet<String> = BTreeSet::new();
-    for s in &exp.strategies {
-        let reason = match known.iter().find(|(n, _)| n == &s.name) {
-            None => Some(format!(
-                "strategy `{}` is unknown to this manylights",
-                s.name
-            )),
-            Some((_, false)) => Some(format!("strategy `{}` is not implemented yet", s.name)),
-            Some(_) => {
-                let bad = manylights::unsupported_flags(&s.cli_args()?, &help);
-                (!bad.is_empty())
-                    .then(|| format!("this manylights does not take {} yet", bad.join(", ")))
-            }
-        };
-        if let Some(r) = reason {
-            notices.push(Notice {
-                what: format!("strategy {}", s.label),
-                skipped: true,
-                message: r,
-            });
-            skip_strategy.insert(s.label.clone());
-        }
-    }
-
-    // scenes that are absent
-    let mut scene_hash: BTreeMap<String, String> = BTreeMap::new();
-    let wanted_scenes: BTreeSet<String> = cells.iter().map(|c| c.scene_label.clone()).collect();
-    for s in &exp.scenes {
-        let label = s.label();
-        if !wanted_scenes.contains(&label) {
-            continue;
-        }
-        if !s.is_builtin() && !root.join(&s.spec).exists() {
-            notices.push(Notice {
-                what: format!("scene {label}"),
-                skipped: true,
-                message: format!("{} is absent", s.spec),
-            });
-            continue;
-        }
-        match ml.info(&s.spec) {
-            Ok(info) => {
-                scene_hash.insert(label, reference::scene_content_hash(&root, &s.spec, &info));
-            }
-            Err(f) => notices.push(Notice {
-                what: format!("scene {label}"),
-                skipped: matches!(f, Failure::Skip(_)),
-                message: match f {
-                    Failure::Skip(m) | Failure::Error(m) => m,
-                },
-            }),
-        }
-    }
-    for n in &notices {
-        eprintln!(
-            "{}: {} — {}",
-            if n.skipped { "skipped" } else { "ERROR" },
-            n.what,
-            n.message
-        );
-    }
-    cells.retain(|c| {
-        scene_hash.contains_key(&c.scene_label) && !skip_strategy.contains(&c.strategy.label)
-    });
-
-    // references
-    let multi = MultiProgress::new();
-    let refs_dir = references_dir();
-    let mut references: BTreeMap<String, Reference> = BTreeMap::new();
-    for s in &exp.scenes {
-        let label = s.label();
-        if !cells.iter().any(|c| c.scene_label == label) {
-            continue;
-        }
-        let (width, height) = plan::scene_resolution(&exp, s);
-        let ensure = Ensure {
-            ml: &ml,
-            refs_dir: &refs_dir,
-            identity: Identity {
-                scene: s.spec.clone(),
-                camera: s.camera.clone(),
-                strategy: exp.reference.strategy.clone(),
-                args: exp.reference.cli_args()?,
-                spp: s.reference_spp.unwrap_or(exp.reference.spp),
-                seed: exp.reference.seed,
-                width,
-                height,
-            },
-            validity: Validity {
-                scene_content_hash: scene_hash[&label].clone(),
-                manylights_version: version.clone(),
-                epoch: reference::REFERENCE_EPOCH,
-            },
-            threads,
-            force: args.refresh_references,
-        };
-        match ensure.run(&multi) {
-            Ok(r) => {
-                references.insert(label, r);
-            }
-            Err(f) => {
-                let skipped = matches!(f, Failure::Skip(_));
-                let message = match f {
-                    Failure::Skip(m) | Failure::Error(m) => m,
-                };
-                say(&multi, format!("reference for {label} failed: {message}")).ok();
-                notices.push(Notice {
-                    what: format!("reference {label}"),
-                    skipped,
-                    message,
-                });
-            }
-        }
-    }
-    cells.retain(|c| references.contains_key(&c.scene_label));
-    if args.references_only {
-        return finish(&exp, &out, notices, start, false);
-    }
-
-    // cells
-    let cells_dir = out.join("cells");
-    let renders_dir = out.join("renders");
-    for d in [&cells_dir, &renders_dir] {
-        std::fs::create_dir_all(d).map_err(|e| format!("cannot create {}: {e}", d.display()))?;
-    }
-    let total = multi.add(ProgressBar::new(cells.len() as u64));
-    total.set_style(style(
-        "cells {pos}/{len} {wide_bar} [{elapsed_precise}, eta {eta}]",
-    ));
-    let mut rendered = 0usize;
-    let mut reused = 0usize;
-    let mut failed = false;
-    let mut skip_now: BTreeSet<String> = BTreeSet::new();
-    for cell in &cells {
-        let id = cell.id();
-        let reference = &references[&cell.scene_label];
-        let key = cell_key(cell);
-        let ref_id = reference.manifest.content_id();
-        let path = cells_dir.join(format!("{id}.json"));
-        if !args.rerender && is_done(&path, &key, &ref_id) {
-            reused += 1;
-            total.inc(1);
-            continue;
-        }
-        if skip_now.contains(&cell.strategy.label) {
-            total.inc(1);
-            continue;
-        }
-        let mut cmd: Vec<String> = vec![
-            cell.scene.spec.clone(),
-            "--strategy".into(),
-            cell.strategy.name.clone(),
-            "--seed".into(),
-            cell.seed.to_string(),
-            "--width".into(),
-            cell.width.to_string(),
-            "--height".into(),
-            cell.height.to_string(),
-        ];
-        let expected = match cell.budget {
-            Budget::Spp(n) => {
-                cmd.extend(["--spp".into(), n.to_string()]);
-                None
-            }
-            Budget::Time(t) => {
-                cmd.extend([
-                    "--time-budget".into(),
-                    t.to_string(),
-                    "--budget-clock".into(),
-                    cell.budget_clock.cli_name().into(),
-                ]);
-                Some(t)
-            }
-        };
-        if let Some(c) = &cell.scene.camera {
-            cmd.extend(["--camera".into(), c.clone()]);
-        }
-        // The render's own light mask (and the strategy's diagnostic maps) for the unlit metric.
-        cmd.push("--aux".into());
-        if let Some(t) = threads {
-            cmd.extend(["--threads".into(), t.to_string()]);
-        }
-        cmd.extend(cell.strategy.cli_args()?);
-        let bar = multi.insert_before(&total, ProgressBar::new(1000));
-        bar.set_style(if expected.is_some() {
-            style("  {spinner} {msg} {bar:30} [{elapsed_precise}]")
-        } else {
-            style("  {spinner} {msg} [{elapsed_precise}]")
-        });
-        bar.set_message(id.clone());
-        let exr = renders_dir.join(format!("{id}.exr"));
-        let result = ml.render(&cmd, &exr, &bar, expected);
-        bar.finish_and_clear();
-        total.inc(1);
-        let json = match result {
-            Ok(j) => j,
-            Err(f) => {
-                let skipped = matches!(f, Failure::Skip(_));
-                let message = match f {
-                    Failure::Skip(m) | Failure::Error(m) => m,
-                };
-                say(
-                    &multi,
-                    format!(
-                        "{} {id}: {message}",
-                        if skipped { "skipped" } else { "FAILED" }
-                    ),
-                )
-                .ok();
-                if skipped {
-                    skip_now.insert(cell.strategy.label.clone());
-                } else {
-                    failed = true;
-                }
-                notices.push(Notice {
-                    what: if skipped {
-                        format!("strategy {}", cell.strategy.label)
-                    } else {
-                        format!("cell {id}")
-                    },
-                    skipped,
-                    message,
-                });
-                continue;
-            }
-        };
-        match measure(cell, &exr, reference, json, &exp.name, key, ref_id) {
-            Ok(r) => {
-                render_core::output::write_json(&path, &serde_json::to_value(&r).unwrap())?;
-                rendered += 1;
-                say(
-                    &multi,
-                    format!(
-                        "{id}: relMSE {:.3e} (unlit) {:.3e} (all), {} spp in {:.2} s",
-                        r.unlit.rel_mse, r.all.rel_mse, r.spp, r.wall_seconds
-                    ),
-                )
-                .ok();
-            }
-            Err(e) => {
-                failed = true;
-                notices.push(Notice {
-                    what: format!("cell {id}"),
-                    skipped: false,
-                    message: e,
-                });
-            }
-        }
-    }
-    total.finish_and_clear();
-    eprintln!(
-        "{rendered} cells rendered, {reused} reused from an earlier run, in {:.1} s",
-        start.elapsed().as_secs_f64()
-    );
-    finish(&exp, &out, notices, start, failed)
-}
-
-fn measure(
-    cell: &Cell,
-    exr: &Path,
-    reference: &Reference,
-    render: serde_json::Value,
-    experiment: &str,
-    key: String,
-    ref_id: String,
-) -> Result<CellResult, String> {
-    let (w, h, px) = render_core::output::read_exr(exr)?;
-    if (w, h)
-        != (
-            reference.manifest.identity.width,
-            reference.manifest.identity.height,
-        )
-    {
-        return Err(format!("render is {w}x{h}, its reference is not"));
-    }
-    let all = render_core::metrics::error_metrics(&px, &reference.pixels, None).into();
-    // Unlit = neither the reference's camera rays nor this render's saw a light. The reference
-    // alone misses lights that cover a tiny part of a pixel; one camera sample of this render
-    // landing on one adds light-seen-directly noise that no light-sampling strategy changes
-    // (at equal spp and seed every strategy shoots the same camera rays, so the same pixels).
-    let own = render_core::output::read_mask_png(&exr.with_extension("mask.png"), w, h)?;
-    let unlit_pixels: Vec<bool> = reference
-        .unlit
-        .iter()
-        .zip(&own)
-        .map(|(&r, &c)| r && c)
-        .collect();
-    let unlit =
-        render_core::metrics::error_metrics(&px, &reference.pixels, Some(&unlit_pixels)).into();
-    Ok(CellResult {
-        id: cell.id(),
-        key,
-        experiment: experiment.to_string(),
-        scene: cell.scene_label.clone(),
-        scene_spec: cell.scene.spec.clone(),
-        strategy: cell.strategy.label.clone(),
-        strategy_name: cell.strategy.name.clone(),
-        strategy_args: cell.strategy.cli_args()?,
-        budget: cell.budget,
-        seed: cell.seed,
-        width: w,
-        height: h,
-        reference: ref_id,
-        reference_dir: reference
-            .dir
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default(),
-        reference_noise_unlit: reference.manifest.noise_unlit.rel_mse,
-        all,
-        unlit,
-        spp: render["spp"].as_u64().unwrap_or(0),
-        wall_seconds: render["wall_seconds"].as_f64().unwrap_or(0.0),
-        cpu_seconds: render["cpu_seconds"].as_f64().unwrap_or(0.0),
-        render,
-    })
 }
 
 /// Merges the notices with those of earlier runs, writes the report.
@@ -639,6 +285,7 @@ pub fn merge_into(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use plan::Budget;
 
     fn cell_file(dir: &Path, id: &str, key: &str, reference: &str) -> PathBuf {
         let c = CellResult {

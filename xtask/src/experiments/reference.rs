@@ -255,8 +255,8 @@ impl Ensure<'_> {
         render_core::output::write_exr(&dir.join("ref.exr"), w, h, &avg).map_err(err)?;
         let lit: Vec<f32> = unlit.iter().map(|&u| if u { 0.0 } else { 1.0 }).collect();
         render_core::output::write_mask_png(&dir.join("mask.png"), w, h, &lit).map_err(err)?;
-        let scale = super::images::auto_exposure(&avg, &unlit);
-        let rgb = super::images::tonemap(&avg, scale);
+        let scale = super::compositing::auto_exposure(&avg, &unlit);
+        let rgb = super::compositing::tonemap(&avg, scale);
         render_core::output::write_png_rgb8(&dir.join("ref.png"), w, h, &rgb).map_err(err)?;
         for name in ["half-a", "half-b"] {
             let _ = std::fs::remove_file(dir.join(format!("{name}.mask.png")));

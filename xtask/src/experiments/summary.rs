@@ -1,7 +1,8 @@
 //! Writes results/<experiment>/{cells.csv, cells.json, table.md, plots/, strips/} from the
 //! finished cell files (needs no renderer: `merge-results` runs it too).
+use super::charts::{self, Series};
+use super::compositing::{self, StripColumn};
 use super::config::{BudgetClock, Experiment};
-use super::images::{self, Series, StripColumn};
 use super::plan::{self, Budget, slug};
 use super::report::{self, CellResult, Entry, Pixels};
 use super::{Notice, cell_key};
@@ -52,6 +53,54 @@ fn grid(cells: &[CellResult], budget: &Budget, pixels: Pixels, clock: BudgetCloc
         .collect()
 }
 
+/// What every table and figure of the report shares: its rows (scenes with results, in the
+/// experiment's order), its columns (strategy labels with results), the baseline column, the
+/// budgets, the clock of the seconds and each scene's reference noise.
+struct Layout<'a> {
+    exp: &'a Experiment,
+    rows: Vec<String>,
+    cols: Vec<String>,
+    budgets: Vec<Budget>,
+    ref_noise: BTreeMap<String, f64>,
+}
+
+impl<'a> Layout<'a> {
+    fn new(exp: &'a Experiment, cells: &[CellResult]) -> Self {
+        let rows = exp
+            .scenes
+            .iter()
+            .map(|s| s.label())
+            .filter(|l| cells.iter().any(|c| &c.scene == l))
+            .collect();
+        let cols = exp
+            .strategies
+            .iter()
+            .map(|s| s.label.clone())
+            .filter(|l| cells.iter().any(|c| &c.strategy == l))
+            .collect();
+        let ref_noise = cells
+            .iter()
+            .map(|c| (c.scene.clone(), c.reference_noise_unlit))
+            .collect();
+        Layout {
+            exp,
+            rows,
+            cols,
+            budgets: budgets(exp),
+            ref_noise,
+        }
+    }
+
+    fn baseline(&self) -> &str {
+        self.exp.baseline()
+    }
+
+    fn clock(&self) -> BudgetClock {
+        self.exp.budget_clock
+    }
+}
+
+/// Writes cells.csv, cells.json, the plots, the strips and table.md of `out`.
 pub fn generate(
     exp: &Experiment,
     out: &Path,
@@ -59,33 +108,34 @@ pub fn generate(
     notices: &[Notice],
 ) -> Result<(), String> {
     let cells = load_cells(exp, out);
+    write_cell_files(out, &cells)?;
+    let layout = Layout::new(exp, &cells);
+    let mut md = String::new();
+    write_header(&mut md, &layout, &cells);
+    write_error_tables(&mut md, &layout, &cells, Pixels::Unlit);
+    write_error_tables(&mut md, &layout, &cells, Pixels::All);
+    write_time_tables(&mut md, &layout, &cells);
+    write_figures(&mut md, &layout, &cells, out, refs_dir)?;
+    write_notices(&mut md, notices);
+    write_missing(&mut md, exp, &cells);
+    render_core::output::write_atomically(&out.join("table.md"), |tmp| {
+        std::fs::write(tmp, &md).map_err(|e| e.to_string())
+    })
+}
+
+/// cells.csv and cells.json: every finished cell.
+fn write_cell_files(out: &Path, cells: &[CellResult]) -> Result<(), String> {
     std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
-    report::write_csv(&out.join("cells.csv"), &cells)?;
+    report::write_csv(&out.join("cells.csv"), cells)?;
     render_core::output::write_json(
         &out.join("cells.json"),
-        &serde_json::to_value(&cells).unwrap(),
-    )?;
+        &serde_json::to_value(cells).unwrap(),
+    )
+}
 
-    let rows: Vec<String> = exp
-        .scenes
-        .iter()
-        .map(|s| s.label())
-        .filter(|l| cells.iter().any(|c| &c.scene == l))
-        .collect();
-    let cols: Vec<String> = exp
-        .strategies
-        .iter()
-        .map(|s| s.label.clone())
-        .filter(|l| cells.iter().any(|c| &c.strategy == l))
-        .collect();
-    let mut ref_noise: BTreeMap<String, f64> = BTreeMap::new();
-    for c in &cells {
-        ref_noise.insert(c.scene.clone(), c.reference_noise_unlit);
-    }
-    let baseline = exp.baseline();
-    let budgets = budgets(exp);
-
-    let mut md = String::new();
+/// Title, description, provenance (cells, commits, threads, clock) and how to read the tables.
+fn write_header(md: &mut String, layout: &Layout, cells: &[CellResult]) {
+    let exp = layout.exp;
     let _ = writeln!(md, "# Experiment `{}`\n", exp.name);
     if !exp.description.is_empty() {
         let _ = writeln!(md, "{}\n", exp.description);
@@ -110,7 +160,7 @@ pub fn generate(
         cells.len(),
         exp.scenes.len(),
         exp.strategies.len(),
-        budgets.len(),
+        layout.budgets.len(),
         exp.seeds.len(),
         if commits.is_empty() {
             "unknown".to_string()
@@ -132,11 +182,12 @@ pub fn generate(
         "Error: relMSE = mean over pixels and channels of (x − r)² / (r² + 0.01) against the reference, \
          over the pixels where no camera ray of the reference or of the render itself sees a light unless the table says \"all pixels\"; \
          mean ± standard deviation over the seeds {:?}. **Bold**: lowest in the row. \
-         (n×): speed-up over the baseline `{baseline}`: at equal time the ratio of relMSE, \
+         (n×): speed-up over the baseline `{}`: at equal time the ratio of relMSE, \
          at equal spp the ratio of relMSE × seconds (how much longer the baseline needs for the same error). \
          *ref. noise*: relMSE between the reference's two independent halves ({} at {} spp in all{}); \
          the reference's own relMSE is about a quarter of it, and differences below it are not real.\n",
         exp.seeds,
+        layout.baseline(),
         exp.reference.strategy,
         exp.reference.spp,
         exp.scenes
@@ -144,96 +195,122 @@ pub fn generate(
             .filter_map(|s| s.reference_spp.map(|n| format!(", {n} for {}", s.label())))
             .collect::<String>()
     );
-    for budget in &budgets {
-        let g = grid(&cells, budget, Pixels::Unlit, exp.budget_clock);
+}
+
+/// One paper-style relMSE table per budget (see [`report::format_table`]).
+fn write_error_tables(md: &mut String, layout: &Layout, cells: &[CellResult], pixels: Pixels) {
+    let which = match pixels {
+        Pixels::Unlit => "",
+        Pixels::All => "all pixels, ",
+    };
+    for budget in &layout.budgets {
+        let g = grid(cells, budget, pixels, layout.clock());
         if g.is_empty() {
             continue;
         }
-        let _ = writeln!(md, "## relMSE, {}\n", budget.describe());
+        let _ = writeln!(md, "## relMSE, {which}{}\n", budget.describe());
         md.push_str(&report::format_table(
-            &rows, &cols, &g, baseline, budget, &ref_noise,
+            &layout.rows,
+            &layout.cols,
+            &g,
+            layout.baseline(),
+            budget,
+            &layout.ref_noise,
         ));
         md.push('\n');
     }
-    for budget in &budgets {
-        let g = grid(&cells, budget, Pixels::All, exp.budget_clock);
-        if g.is_empty() {
-            continue;
-        }
-        let _ = writeln!(md, "## relMSE, all pixels, {}\n", budget.describe());
-        md.push_str(&report::format_table(
-            &rows, &cols, &g, baseline, budget, &ref_noise,
-        ));
-        md.push('\n');
-    }
-    for budget in &budgets {
-        let g = grid(&cells, budget, Pixels::Unlit, exp.budget_clock);
+}
+
+/// One table of seconds and spp reached per budget.
+fn write_time_tables(md: &mut String, layout: &Layout, cells: &[CellResult]) {
+    for budget in &layout.budgets {
+        let g = grid(cells, budget, Pixels::Unlit, layout.clock());
         if g.is_empty() {
             continue;
         }
         let _ = writeln!(
             md,
             "## {} / spp reached, {}\n",
-            clock_words(exp.budget_clock),
+            clock_words(layout.clock()),
             budget.describe()
         );
-        md.push_str(&report::format_time_table(&rows, &cols, &g));
+        md.push_str(&report::format_time_table(&layout.rows, &layout.cols, &g));
         md.push('\n');
     }
+}
 
-    // plots
+/// The curves of one scene's convergence plot: per strategy, relMSE against spp (spp
+/// budgets only) and against seconds (every budget).
+fn convergence_series(
+    layout: &Layout,
+    cells: &[CellResult],
+    scene: &str,
+) -> (Vec<Series>, Vec<Series>) {
+    let mut vs_spp = Vec::new();
+    let mut vs_sec = Vec::new();
+    for col in &layout.cols {
+        let mut a = Vec::new();
+        let mut b = Vec::new();
+        for budget in &layout.budgets {
+            let sel: Vec<&CellResult> = cells
+                .iter()
+                .filter(|c| c.scene == scene && &c.strategy == col && &c.budget == budget)
+                .collect();
+            if sel.is_empty() {
+                continue;
+            }
+            let e = report::entry(&sel, Pixels::Unlit, layout.clock());
+            if let Budget::Spp(n) = budget {
+                a.push((*n as f64, e.error.mean, e.error.std));
+            }
+            b.push((e.seconds, e.error.mean, e.error.std));
+        }
+        b.sort_by(|x, y| x.0.total_cmp(&y.0));
+        if !a.is_empty() {
+            vs_spp.push(Series {
+                label: col.clone(),
+                points: a,
+            });
+        }
+        if !b.is_empty() {
+            vs_sec.push(Series {
+                label: col.clone(),
+                points: b,
+            });
+        }
+    }
+    (vs_spp, vs_sec)
+}
+
+/// Per scene a convergence plot (plots/) and a comparison strip (strips/, where the renders
+/// and the reference are on this machine), and the section that shows them.
+fn write_figures(
+    md: &mut String,
+    layout: &Layout,
+    cells: &[CellResult],
+    out: &Path,
+    refs_dir: &Path,
+) -> Result<(), String> {
     let plots_dir = out.join("plots");
     let strips_dir = out.join("strips");
     for d in [&plots_dir, &strips_dir] {
         std::fs::create_dir_all(d).map_err(|e| e.to_string())?;
     }
     let mut figures = String::new();
-    for scene in &rows {
-        let mut vs_spp = Vec::new();
-        let mut vs_sec = Vec::new();
-        for col in &cols {
-            let mut a = Vec::new();
-            let mut b = Vec::new();
-            for budget in &budgets {
-                let sel: Vec<&CellResult> = cells
-                    .iter()
-                    .filter(|c| &c.scene == scene && &c.strategy == col && &c.budget == budget)
-                    .collect();
-                if sel.is_empty() {
-                    continue;
-                }
-                let e = report::entry(&sel, Pixels::Unlit, exp.budget_clock);
-                if let Budget::Spp(n) = budget {
-                    a.push((*n as f64, e.error.mean, e.error.std));
-                }
-                b.push((e.seconds, e.error.mean, e.error.std));
-            }
-            b.sort_by(|x, y| x.0.total_cmp(&y.0));
-            if !a.is_empty() {
-                vs_spp.push(Series {
-                    label: col.clone(),
-                    points: a,
-                });
-            }
-            if !b.is_empty() {
-                vs_sec.push(Series {
-                    label: col.clone(),
-                    points: b,
-                });
-            }
-        }
+    for scene in &layout.rows {
+        let (vs_spp, vs_sec) = convergence_series(layout, cells, scene);
         let file = format!("{}.png", slug(scene));
-        let floor = ref_noise.get(scene).map(|n| n / 4.0);
-        images::convergence_plot(
+        let floor = layout.ref_noise.get(scene).map(|n| n / 4.0);
+        charts::convergence_plot(
             &plots_dir.join(&file),
             &format!("{scene}: relMSE (unlit pixels), mean ± std over seeds"),
             &vs_spp,
             &vs_sec,
-            &clock_words(exp.budget_clock).to_lowercase(),
+            &clock_words(layout.clock()).to_lowercase(),
             floor,
         )?;
         let _ = writeln!(figures, "![{scene}: convergence](plots/{file})\n");
-        match strip(exp, out, refs_dir, scene, &cols, &cells) {
+        match strip(layout.exp, out, refs_dir, scene, &layout.cols, cells) {
             Ok(Some(f)) => {
                 let _ = writeln!(figures, "![{scene}: comparison](strips/{f})\n");
             }
@@ -255,19 +332,29 @@ pub fn generate(
         );
         md.push_str(&figures);
     }
-    if !notices.is_empty() {
-        md.push_str("## Skipped and failed\n\n");
-        for n in notices {
-            let _ = writeln!(
-                md,
-                "- {} {}: {}",
-                if n.skipped { "skipped" } else { "**failed**" },
-                n.what,
-                n.message
-            );
-        }
-        md.push('\n');
+    Ok(())
+}
+
+/// The skipped and failed scenes, strategies, references and cells.
+fn write_notices(md: &mut String, notices: &[Notice]) {
+    if notices.is_empty() {
+        return;
     }
+    md.push_str("## Skipped and failed\n\n");
+    for n in notices {
+        let _ = writeln!(
+            md,
+            "- {} {}: {}",
+            if n.skipped { "skipped" } else { "**failed**" },
+            n.what,
+            n.message
+        );
+    }
+    md.push('\n');
+}
+
+/// How many planned cells have no result.
+fn write_missing(md: &mut String, exp: &Experiment, cells: &[CellResult]) {
     let missing = plan::expand(exp)
         .iter()
         .filter(|c| !cells.iter().any(|r| r.id == c.id()))
@@ -278,9 +365,6 @@ pub fn generate(
             "{missing} planned cells have no result (skipped, failed, filtered out by --only/--shard, or not run yet).\n"
         );
     }
-    render_core::output::write_atomically(&out.join("table.md"), |tmp| {
-        std::fs::write(tmp, &md).map_err(|e| e.to_string())
-    })
 }
 
 /// The comparison strip of `scene` (None when its renders or reference are not on this machine).
@@ -338,9 +422,9 @@ fn strip(
         let rgb: Vec<u8> = err
             .iter()
             .zip(&unlit)
-            .flat_map(|(v, u)| images::error_colour(*v, *u))
+            .flat_map(|(v, u)| compositing::error_colour(*v, *u))
             .collect();
-        images::save_png(
+        compositing::save_png(
             &maps.join(format!("{}__{}.png", slug(scene), slug(col))),
             w,
             h,
@@ -380,7 +464,7 @@ fn strip(
                 .zip(&unlit)
                 .map(|(e, u)| if *u { e.min(100.0) } else { 0.0 })
                 .collect();
-            images::pick_insets(&score, w, h, 2)
+            compositing::pick_insets(&score, w, h, 2)
         }
     };
     let file = format!("{}.png", slug(scene));
@@ -388,7 +472,7 @@ fn strip(
         Budget::Spp(n) => format!("{n} spp"),
         Budget::Time(t) => format!("{t} s"),
     };
-    images::comparison_strip(
+    compositing::comparison_strip(
         &out.join("strips").join(&file),
         &format!("{scene} — {desc}, seed {}", exp.seeds[0]),
         w,

@@ -7,8 +7,8 @@
 use super::mesh::Mesh;
 use super::{Params, uniform};
 use crate::camera::Camera;
+use crate::colour::luminance;
 use crate::error::SceneError;
-use crate::light::luminance;
 use crate::material::Material;
 use crate::scene::SceneBuilder;
 use glam::{Mat4, Vec3};

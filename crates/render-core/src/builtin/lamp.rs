@@ -120,7 +120,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
             uniform(&mut rng, 0.7, 0.85),
             uniform(&mut rng, 0.45, 0.6),
         );
-        b.add_sphere_light(c, radius, warm / crate::light::luminance(warm) * l, None)?;
+        b.add_sphere_light(c, radius, warm / crate::colour::luminance(warm) * l, None)?;
     }
     b.add_camera(Camera::look_at(
         "main",

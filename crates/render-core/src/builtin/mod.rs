@@ -386,7 +386,7 @@ pub fn light_color(rng: &mut Pcg32) -> Vec3 {
         [1.0, 1.0, 1.0],
     ];
     let c = Vec3::from(PALETTE[(rng.random::<u32>() % PALETTE.len() as u32) as usize]);
-    c / crate::light::luminance(c)
+    c / crate::colour::luminance(c)
 }
 
 /// Radiance (luminance) of each of `n` sphere lights of radius `r` so that together they emit

@@ -383,7 +383,7 @@ fn every_builtin_renders_a_lit_image() {
             .iter()
             .zip(&r.light_fraction)
             .filter(|(_, f)| **f == 0.0)
-            .map(|(p, _)| crate::light::luminance(*p))
+            .map(|(p, _)| crate::colour::luminance(*p))
             .collect();
         assert!(
             lit.iter().all(|v| v.is_finite() && *v >= 0.0),

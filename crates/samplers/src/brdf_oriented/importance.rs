@@ -13,13 +13,10 @@ use brdf_integrals::LobeIntegral;
 use brdf_integrals::cap::{Cap, intersection_area_exact, intersection_area_oat_sander};
 use light_tree::Node;
 use render_core::Vec3;
+use render_core::colour::luminance;
 use render_core::estimator::ShadingPoint;
 use render_core::frame::Frame;
 use std::f32::consts::PI;
-
-fn luminance(c: Vec3) -> f32 {
-    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
-}
 
 /// What the BO importance needs of a shading point; built once per shading point.
 #[derive(Clone, Copy, Debug)]

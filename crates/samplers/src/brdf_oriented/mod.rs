@@ -28,6 +28,34 @@ pub enum BrdfIntegral {
     Ltc,
 }
 
+impl BrdfIntegral {
+    pub const ALL: [BrdfIntegral; 2] = [BrdfIntegral::Sptd, BrdfIntegral::Ltc];
+
+    /// The name on the command line and in the render's JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            BrdfIntegral::Sptd => "sptd",
+            BrdfIntegral::Ltc => "ltc",
+        }
+    }
+}
+
+impl std::fmt::Display for BrdfIntegral {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for BrdfIntegral {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        BrdfIntegral::ALL
+            .into_iter()
+            .find(|b| b.name() == s)
+            .ok_or_else(|| format!("unknown BRDF integral `{s}` (known: sptd, ltc)"))
+    }
+}
+
 /// Knobs of the method (recorded in the render's JSON).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BoConfig {
