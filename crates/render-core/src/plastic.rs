@@ -40,7 +40,7 @@ pub fn material(name: &str, kd: Vec3, ks: Vec3, roughness: f32, remap_roughness:
 mod tests {
     use super::*;
     use crate::bsdf::Bsdf;
-    use crate::chi2::{chi2_directions, sidak_significance};
+    use chi2_test::{chi2_directions, sidak_significance};
     use crate::rng::SampleStream;
     use glam::Vec2;
     use std::f64::consts::PI;
