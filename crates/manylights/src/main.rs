@@ -19,13 +19,21 @@ struct Cli {
 enum Command {
     /// Render a scene with a light-sampling strategy to a linear EXR (+ JSON metadata).
     Render(render_cmd::RenderArgs),
-    /// Print a scene's triangles, lights by kind, total power and bounds.
+    /// Print a scene's triangles, lights by kind, total power, bounds and load warnings.
     Info {
-        /// A glTF file (.gltf/.glb) or `builtin:NAME?key=value&...`.
+        /// A glTF file (.gltf/.glb), a pbrt scene (.pbrt), a composition (.toml) or
+        /// `builtin:NAME?key=value&...`.
         scene: String,
         /// Print JSON instead of text.
         #[arg(long)]
         json: bool,
+    },
+    /// Write a loaded scene as binary glTF (.glb), with pbrt materials in `extras.pbrt`.
+    Convert {
+        /// Any scene `render` accepts (e.g. a .pbrt file).
+        scene: String,
+        /// Output .glb.
+        out: std::path::PathBuf,
     },
     /// List the built-in scenes and their keys.
     Scenes,
@@ -63,6 +71,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),
         Command::Info { scene, json } => info(&scene, json),
+        Command::Convert { scene, out } => convert(&scene, &out),
         Command::Scenes => {
             list_scenes();
             Ok(())
@@ -98,6 +107,23 @@ fn list_scenes() {
             println!("    {key:<10} default {default:<10} {help}");
         }
     }
+}
+
+fn convert(spec: &str, out: &std::path::Path) -> anyhow::Result<()> {
+    let scene = render_core::load_scene(spec, None)?;
+    for w in &scene.stats.warnings {
+        eprintln!("warning: {w}");
+    }
+    for w in render_core::gltf_writer::write_glb(&scene, out)? {
+        eprintln!("warning: {w}");
+    }
+    println!(
+        "wrote {} ({} triangles, {} lights)",
+        out.display(),
+        scene.triangles.len(),
+        scene.lights.len() + scene.distant_lights.len()
+    );
+    Ok(())
 }
 
 fn info(spec: &str, json: bool) -> anyhow::Result<()> {
@@ -142,6 +168,9 @@ fn info(spec: &str, json: bool) -> anyhow::Result<()> {
                 .join(", ")
         }
     );
+    for w in &s.warnings {
+        println!("warning        {w}");
+    }
     Ok(())
 }
 

@@ -10,7 +10,8 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub struct RenderArgs {
-    /// A glTF file (.gltf/.glb) or `builtin:NAME?key=value&...`.
+    /// A glTF file (.gltf/.glb), a pbrt scene (.pbrt), a composition (.toml) or
+    /// `builtin:NAME?key=value&...`.
     pub scene: String,
     #[arg(long, default_value = "power+bsdf")]
     pub strategy: String,
@@ -190,6 +191,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         check_writable(p)?;
     }
     let scene = render_core::load_scene(&args.scene, args.camera.as_deref())?;
+    if !args.quiet {
+        for w in &scene.stats.warnings {
+            eprintln!("warning: {w}");
+        }
+    }
     let opts = args.method.options(args.tau, args.max_cut);
     let strategy = samplers::create(&args.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {

@@ -430,3 +430,74 @@ fn cap_integral_batch_agrees_across_methods() {
     let o = run("nope", "");
     assert!(!o.status.success() && String::from_utf8_lossy(&o.stderr).contains("unknown method"));
 }
+
+/// A pbrt scene through the command line: `info` lists its warnings with file and line,
+/// `convert` writes a glTF that loads back, `render` draws it, and a malformed file is one
+/// `error:` line naming file and line.
+#[test]
+fn pbrt_scenes_info_convert_render_and_errors() {
+    let dir = temp_dir("pbrt");
+    let scene = dir.join("lamp.pbrt");
+    std::fs::write(
+        &scene,
+        "LookAt 0 1 4  0 0.5 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\n\
+         Film \"rgb\" \"integer xresolution\" 16 \"integer yresolution\" 12\nWorldBegin\n\
+         Material \"plastic\" \"rgb Kd\" [ .3 .1 .2 ] \"rgb Ks\" [ .7 .7 .7 ] \"float roughness\" .01 \"bool remaproughness\" false\n\
+         Shape \"bilinearmesh\" \"point3 P\" [ -2 0 -2  2 0 -2  -2 0 2  2 0 2 ]\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 50 50 50 ]\nTranslate 0 1.5 0\n\
+         Shape \"sphere\" \"float radius\" 0.05\nAttributeEnd\n\
+         LightSource \"infinite\" \"rgb L\" [ 1 1 1 ]\n",
+    )
+    .unwrap();
+    let s = scene.to_str().unwrap();
+    let o = manylights(&["info", s]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{text}");
+    assert!(text.contains("1 sphere"), "{text}");
+    assert!(
+        text.contains("lamp.pbrt:12: LightSource \"infinite\" is not supported"),
+        "{text}"
+    );
+    let glb = dir.join("lamp.glb");
+    let o = manylights(&["convert", s, glb.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let o = manylights(&["info", glb.to_str().unwrap()]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("1 sphere"));
+    let out = dir.join("lamp.exr");
+    let o = manylights(&[
+        "render",
+        s,
+        "--strategy",
+        "mis3-adaptive",
+        "--spp",
+        "2",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(out.exists());
+
+    let bad_dir = temp_dir("pbrt-bad");
+    let outputs = temp_dir("pbrt-bad-out");
+    let bad = bad_dir.join("bad.pbrt");
+    std::fs::write(
+        &bad,
+        "WorldBegin\nShape \"sphere\" \"float radius\" \"big\"\n",
+    )
+    .unwrap();
+    let out = outputs.join("x.exr");
+    assert_clean_failure(
+        &outputs,
+        &[
+            "render",
+            bad.to_str().unwrap(),
+            "--spp",
+            "1",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "bad.pbrt:2: parameter",
+    );
+}

@@ -1,4 +1,4 @@
-//! Scene composition files (TOML): real glTF assets placed in a studio with a ground, material
+//! Scene composition files (TOML): real glTF (or pbrt, `.pbrt`) assets placed in a studio with a ground, material
 //! overrides where a study needs glossiness, light layouts of many small spheres or quads, and
 //! a camera. Paths are relative to the composition file.
 //!
@@ -227,6 +227,15 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
     b.build()
 }
 
+/// A glTF file, or a pbrt scene (`.pbrt`) placed the same way.
+fn add_asset(b: &mut SceneBuilder, file: &Path, transform: Mat4) -> Result<(), SceneError> {
+    if file.extension().is_some_and(|e| e == "pbrt") {
+        crate::pbrt::add_pbrt(b, file, transform).map(|_| ())
+    } else {
+        add_gltf(b, file, transform).map(|_| ())
+    }
+}
+
 fn add_part(b: &mut SceneBuilder, dir: &Path, part: &GltfPart) -> Result<(), SceneError> {
     let file = dir.join(&part.path);
     let rotation = Mat4::from_rotation_y(part.rotate_y_deg.to_radians());
@@ -236,7 +245,7 @@ fn add_part(b: &mut SceneBuilder, dir: &Path, part: &GltfPart) -> Result<(), Sce
     if let Some(size) = part.fit_size {
         // Measure the asset alone, then scale it to `size`, centred, resting on y = translate.y.
         let mut probe = SceneBuilder::new("probe");
-        add_gltf(&mut probe, &file, rotation)?;
+        add_asset(&mut probe, &file, rotation)?;
         let (lo, hi) = probe
             .bounds()
             .ok_or_else(|| bad(&file, "nothing to place"))?;
@@ -248,7 +257,7 @@ fn add_part(b: &mut SceneBuilder, dir: &Path, part: &GltfPart) -> Result<(), Sce
             * rotation;
     }
     let first_material = b.material_count();
-    add_gltf(b, &file, transform)?;
+    add_asset(b, &file, transform)?;
     if !part.keep_cameras {
         b.clear_cameras();
     }

@@ -19,11 +19,13 @@ pub mod estimator;
 pub mod frame;
 pub mod fresnel;
 pub mod gltf_loader;
+pub mod gltf_writer;
 pub mod light;
 pub mod material;
 pub mod metrics;
 pub mod microfacet;
 pub mod output;
+pub mod pbrt;
 pub mod pbrt_extras;
 pub mod plastic;
 pub mod render;
@@ -37,7 +39,7 @@ pub use error::SceneError;
 pub use glam::{Vec2, Vec3};
 
 /// Loads a scene named on the command line: `builtin:NAME?key=value&…`, a composition file
-/// (`.toml`, see [`composition`]) or a glTF path.
+/// (`.toml`, see [`composition`]), a pbrt scene (`.pbrt`, see [`pbrt`]) or a glTF path.
 pub fn load_scene(spec: &str, camera: Option<&str>) -> Result<scene::Scene, SceneError> {
     if spec.starts_with("builtin:") {
         let mut scene = builtin::load_builtin(spec)?;
@@ -47,6 +49,8 @@ pub fn load_scene(spec: &str, camera: Option<&str>) -> Result<scene::Scene, Scen
         let mut scene = composition::load_composition(std::path::Path::new(spec))?;
         gltf_loader::select_camera(&mut scene, camera)?;
         Ok(scene)
+    } else if spec.ends_with(".pbrt") {
+        pbrt::load_pbrt(std::path::Path::new(spec), camera)
     } else {
         gltf_loader::load_gltf(std::path::Path::new(spec), camera)
     }

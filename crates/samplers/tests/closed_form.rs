@@ -95,3 +95,75 @@ fn point_light_is_exact_for_light_sampling() {
         );
     }
 }
+
+/// Point-to-polygon irradiance of a unit-radiance polygon facing the point (Lambert's
+/// formula), for a receiver at the origin with normal +z.
+fn polygon_irradiance(v: &[[f64; 3]]) -> f64 {
+    let mut e = 0.0;
+    for k in 0..v.len() {
+        let a = glam::DVec3::from(v[k]).normalize();
+        let b = glam::DVec3::from(v[(k + 1) % v.len()]).normalize();
+        let g = a.cross(b);
+        e += a.dot(b).clamp(-1.0, 1.0).acos() * g.z / g.length();
+    }
+    0.5 * e.abs()
+}
+
+/// The pbrt loader's sphere and disk lights (a `Shape "sphere"` and a `Shape "disk"` under an
+/// `AreaLightSource`) against closed-form irradiance, with every baseline strategy.
+#[test]
+fn pbrt_sphere_and_disk_lights_over_lambertian_plane() {
+    let dir = std::env::temp_dir().join(format!("samplers-pbrt-lights-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let (radius, centre, radiance) = (0.3f64, [0.4, 0.0, 1.0], 5.0f64);
+    let (disk_r, disk_h, disk_l) = (0.6f64, 0.9f64, 3.0f64);
+    let scenes = [
+        (
+            "sphere.pbrt",
+            format!(
+                "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ {radiance} {radiance} {radiance} ]\nTranslate {} {} {}\nShape \"sphere\" \"float radius\" {radius}\nAttributeEnd\n",
+                centre[0], centre[1], centre[2]
+            ),
+        ),
+        (
+            "disk.pbrt",
+            // the disk faces +z in object space: turn it over to face the floor
+            format!(
+                "AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ {disk_l} {disk_l} {disk_l} ]\nTranslate 0 0 {disk_h}\nScale 1 1 -1\nShape \"disk\" \"float radius\" {disk_r}\nAttributeEnd\n"
+            ),
+        ),
+    ];
+    for (name, text) in scenes {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        let mut b = SceneBuilder::new(name);
+        floor(&mut b, 50.0);
+        render_core::pbrt::add_pbrt(&mut b, &path, glam::Mat4::IDENTITY).unwrap();
+        let scene = b.build().unwrap();
+        let expected = if name == "sphere.pbrt" {
+            assert_eq!(scene.stats.sphere_lights, 1);
+            let d = glam::DVec3::from(centre).length();
+            radiance * (radius / d).powi(2) * centre[2] / d
+        } else {
+            let n = render_core::pbrt::shapes::SEGMENTS;
+            assert_eq!(scene.stats.triangle_lights, n);
+            // the tessellated disk: a regular n-gon inscribed in the circle
+            let v: Vec<[f64; 3]> = (0..n)
+                .map(|k| {
+                    let phi = 2.0 * PI * k as f64 / n as f64;
+                    [disk_r * phi.cos() - 1e-3, disk_r * phi.sin() - 2e-3, disk_h]
+                })
+                .collect();
+            disk_l * polygon_irradiance(&v) / PI
+        };
+        for s in STRATEGIES {
+            let st = create(s, &scene, &StrategyOptions::default()).unwrap();
+            let (mean, se) = estimate_at_origin(&scene, st.as_ref(), 40_000, 4);
+            assert!(
+                (mean - expected).abs() < 3.0 * se + 1e-6,
+                "{name} {s}: {mean} ± {se}, expected {expected}"
+            );
+            assert!(se < 0.05 * expected, "{name} {s}: too noisy to test ({se})");
+        }
+    }
+}

@@ -1,0 +1,463 @@
+//! The pbrt loader against small scenes written by the tests.
+use super::*;
+use crate::light::LightShape;
+use crate::material::{Model, Specular};
+use glam::{Vec2, Vec3};
+use std::path::PathBuf;
+
+fn dir(test: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("render-core-pbrt-{}-{test}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn write(d: &Path, name: &str, text: &str) -> PathBuf {
+    let p = d.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+/// A binary little-endian PLY triangle with normals, and an ASCII PLY quad without.
+fn write_plys(d: &Path) {
+    let mut bin = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+    for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, -1.0]] {
+        for x in v.iter().chain(&[0.0, 1.0, 0.0]) {
+            bin.extend(x.to_le_bytes());
+        }
+    }
+    bin.push(3);
+    for i in [0i32, 1, 2] {
+        bin.extend(i.to_le_bytes());
+    }
+    std::fs::write(d.join("tri.ply"), bin).unwrap();
+    write(
+        d,
+        "quad.ply",
+        "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar uint vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n4 0 1 2 3\n",
+    );
+}
+
+const SCENE: &str = r#"# every directive the loader maps
+LookAt 0 1 5   0 1 0   0 1 0
+Camera "perspective" "float fov" [ 40 ]
+Film "rgb" "integer xresolution" [ 64 ] "integer yresolution" [ 32 ] "string filename" "x.exr"
+Sampler "halton" "integer pixelsamples" 16
+Integrator "path" "integer maxdepth" [ 5 ]
+PixelFilter "triangle"
+WorldBegin
+Texture "grey" "spectrum" "constant" "rgb value" [ 0.2 0.4 0.6 ]
+Texture "checks" "spectrum" "checkerboard" "float uscale" 4
+MakeNamedMaterial "walls" "string type" "matte" "rgb Kd" [ .725 .71 .68 ]
+MakeNamedMaterial "bunny" "string type" [ "plastic" ] "rgb Kd" [ .3 .1 .2 ] "rgb Ks" [ .7 .7 .7 ]
+    "float roughness" [ 0.008 ] "bool remaproughness" [ "false" ]
+MakeNamedMaterial "gold" "string type" "conductor" "rgb reflectance" [ 1 0.8 0.3 ] "float roughness" 0.1
+    "bool remaproughness" false
+MakeNamedMaterial "coat" "string type" "coateddiffuse" "rgb reflectance" [ 0.5 0.5 0.5 ]
+MakeNamedMaterial "glass" "string type" "dielectric" "float eta" 1.5
+MakeNamedMaterial "checked" "string type" "diffuse" "texture reflectance" "checks"
+Material "diffuse" "texture reflectance" "grey"
+AttributeBegin
+  Translate 10 0 0
+  Rotate 90 0 0 1
+  Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  0 1 0 ] "integer indices" [ 0 1 2 ]
+AttributeEnd
+TransformBegin
+  Transform [ 1 0 0 0  0 1 0 0  0 0 1 0  0 20 0 1 ]
+  ConcatTransform [ 2 0 0 0  0 2 0 0  0 0 2 0  0 0 0 1 ]
+  NamedMaterial "walls"
+  Shape "bilinearmesh" "point3 P" [ 0 0 0  1 0 0  0 0 1  1 0 1 ]
+TransformEnd
+AttributeBegin
+  NamedMaterial "bunny"
+  Translate 0 -10 0
+  Shape "plymesh" "string filename" "tri.ply"
+  Scale 1 1 -1
+  Shape "plymesh" "string filename" "quad.ply"
+AttributeEnd
+AttributeBegin
+  CoordSysTransform "camera"
+  Translate 0 0 1
+  CoordinateSystem "in front"
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.01 0 0  0 0.01 0 ]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 300 180 225 ] "float scale" 2
+  NamedMaterial "walls"
+  Translate 0.999 0.5 -0.5
+  Shape "sphere" "float radius" [ 0.01 ]
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 4 4 4 ] "bool twosided" true
+  Translate 0 1.9 0
+  Rotate 90 1 0 0
+  Shape "disk" "float radius" 0.5
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [ 1 2 3 ]
+  ReverseOrientation
+  Shape "trianglemesh" "point3 P" [ 0 3 0  1 3 0  0 3 1 ] "integer indices" [ 0 1 2 ]
+AttributeEnd
+AttributeBegin
+  NamedMaterial "gold"
+  Translate 0 -5 0
+  Shape "sphere" "float radius" 0.5
+AttributeEnd
+ObjectBegin "leaf"
+  NamedMaterial "coat"
+  Shape "trianglemesh" "point3 P" [ 0 0 0  0.1 0 0  0 0.1 0 ]
+ObjectEnd
+AttributeBegin
+  Translate 0 0 -30
+  ObjectInstance "leaf"
+  Translate 1 0 0
+  ObjectInstance "leaf"
+AttributeEnd
+LightSource "point" "rgb I" [ 5 5 5 ] "point3 from" [ 0 1.5 0 ]
+LightSource "spot" "rgb I" [ 1 1 1 ] "point3 from" [ 0 2 0 ] "point3 to" [ 0 0 0 ] "float coneangle" 30 "float conedelta" 10
+LightSource "distant" "rgb L" [ 2 2 2 ] "point3 from" [ 0 1 0 ] "point3 to" [ 0 0 0 ]
+LightSource "infinite" "rgb L" [ 1 1 1 ]
+NamedMaterial "glass"
+Include "more.pbrt"
+Import "more2.pbrt"
+MakeNamedMedium "fog" "string type" "homogeneous"
+Shape "curve" "point3 P" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]
+WorldEnd
+"#;
+
+fn load_test_scene() -> (crate::scene::Scene, PbrtReport, PathBuf) {
+    let d = dir("every");
+    write_plys(&d);
+    write(
+        &d,
+        "more.pbrt",
+        "NamedMaterial \"checked\"\nShape \"trianglemesh\" \"point3 P\" [ 5 5 5  6 5 5  5 6 5 ]\n",
+    );
+    write(
+        &d,
+        "more2.pbrt",
+        "NamedMaterial \"glass\"\nShape \"trianglemesh\" \"point3 P\" [ 7 7 7  8 7 7  7 8 7 ]\n",
+    );
+    let path = write(&d, "scene.pbrt", SCENE);
+    let (scene, report) = load_pbrt_with_report(&path, None).unwrap();
+    (scene, report, path)
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-4
+}
+
+#[test]
+fn every_directive_loads_to_the_expected_scene() {
+    let (scene, report, _) = load_test_scene();
+    let sphere_tris = shapes::sphere(0.5).indices.len() / 3;
+    // 1 + 2 (bilinear) + 1 + 2 (plys) + 1 (camera space) + 64 (disk) + 1 (reversed)
+    // + sphere + 2 (instances) + 1 + 1 (includes)
+    let want = 1 + 2 + 3 + 1 + shapes::SEGMENTS + 1 + sphere_tris + 2 + 2;
+    assert_eq!(
+        (
+            scene.triangles.len(),
+            scene.stats.degenerate_triangles_skipped
+        ),
+        (want, 0),
+        "{:#?}",
+        report.warnings
+    );
+    let s = &scene.stats;
+    assert_eq!(
+        (
+            s.sphere_lights,
+            s.point_lights,
+            s.spot_lights,
+            s.distant_lights
+        ),
+        (1, 1, 1, 1)
+    );
+    assert_eq!(s.triangle_lights, shapes::SEGMENTS + 1);
+    assert_eq!(report.instances, 2);
+
+    // transforms: Translate 10 then Rotate 90° about z maps (1, 0, 0) to (10, 1, 0)
+    assert!(
+        scene
+            .triangles
+            .iter()
+            .any(|t| close(t.p[1], Vec3::new(10.0, 1.0, 0.0)))
+    );
+    // Transform then ConcatTransform: (1, 0, 1) → 2 × (1, 0, 1) + (0, 20, 0)
+    assert!(
+        scene
+            .triangles
+            .iter()
+            .any(|t| t.p.iter().any(|&p| close(p, Vec3::new(2.0, 20.0, 2.0))))
+    );
+    // the mirrored PLY quad lies at z ≤ 0 with y from −10 to −9
+    let quad: Vec<_> = scene
+        .triangles
+        .iter()
+        .filter(|t| {
+            t.p.iter()
+                .all(|p| p.y <= -9.0 + 1e-4 && p.y >= -10.0 - 1e-4 && p.z.abs() < 1e-6)
+        })
+        .collect();
+    assert_eq!(quad.len(), 2);
+    // instances at z = −30, x = 0 and 1
+    for x in [0.0, 1.0] {
+        assert!(
+            scene
+                .triangles
+                .iter()
+                .any(|t| close(t.p[0], Vec3::new(x, 0.0, -30.0)))
+        );
+    }
+
+    // camera: LookAt from (0, 1, 5) towards (0, 1, 0); pbrt's LookAt frame is mirrored for a
+    // right-handed scene, fov 40° on the shorter (vertical) axis of 64 × 32
+    let cam = scene.camera(None).unwrap();
+    assert!(close(cam.position, Vec3::new(0.0, 1.0, 5.0)));
+    assert!(close(cam.forward, Vec3::NEG_Z) && close(cam.up, Vec3::Y));
+    assert!(cam.mirrored);
+    assert!(
+        close(cam.right(), Vec3::NEG_X),
+        "pbrt's LookAt puts world −x on the image's right here"
+    );
+    assert_eq!((cam.width, cam.height), (64, 32));
+    assert!((cam.yfov - 40f32.to_radians()).abs() < 1e-6);
+    // CoordSysTransform "camera" + Translate 0 0 1: one unit in front of the eye
+    assert!(
+        scene
+            .triangles
+            .iter()
+            .any(|t| t.p.iter().any(|&p| close(p, Vec3::new(0.0, 1.0, 4.0))))
+    );
+
+    // materials
+    let m = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap_or_else(|| panic!("{name}"))
+    };
+    assert_eq!(m("walls").params_at(Vec2::ZERO).specular, Specular::None);
+    assert_eq!(
+        m("bunny").model,
+        Model::PbrtPlastic {
+            ks: Vec3::splat(0.7),
+            alpha: 0.008
+        }
+    );
+    assert_eq!(m("bunny").base_color, Vec3::new(0.3, 0.1, 0.2));
+    assert_eq!(
+        (m("gold").metallic, m("gold").base_color),
+        (1.0, Vec3::new(1.0, 0.8, 0.3))
+    );
+    assert!((m("gold").roughness - 0.1f32.sqrt()).abs() < 1e-6);
+    assert!(
+        matches!(m("glass").params_at(Vec2::ZERO).specular, Specular::Schlick { f0 } if (f0.x - 0.04).abs() < 1e-6)
+    );
+    assert_eq!(m("glass").base_color, Vec3::ZERO);
+    assert_eq!(
+        m("checked").base_color,
+        Vec3::splat(0.5),
+        "a non-constant texture takes the default"
+    );
+    let textured = scene
+        .triangles
+        .iter()
+        .find(|t| close(t.p[0], Vec3::new(10.0, 0.0, 0.0)))
+        .unwrap();
+    assert_eq!(
+        scene.materials[textured.material as usize].base_color,
+        Vec3::new(0.2, 0.4, 0.6)
+    );
+
+    // lights
+    let sphere = scene
+        .lights
+        .iter()
+        .find(|l| matches!(l.shape, LightShape::Sphere { .. }))
+        .unwrap();
+    let LightShape::Sphere { center, radius } = sphere.shape else {
+        unreachable!()
+    };
+    assert!(close(center, Vec3::new(0.999, 0.5, -0.5)) && (radius - 0.01).abs() < 1e-7);
+    assert_eq!(sphere.emission, Vec3::new(600.0, 360.0, 450.0));
+    // the disk (rotated +90° about x: its +z normal points to −y) emits on both sides
+    let disk: Vec<_> = scene
+        .lights
+        .iter()
+        .filter(|l| l.emission == Vec3::splat(4.0))
+        .collect();
+    assert_eq!(disk.len(), shapes::SEGMENTS);
+    assert!(disk.iter().all(|l| l.two_sided
+        && matches!(l.shape, LightShape::Triangle { normal, .. } if close(normal, Vec3::NEG_Y))));
+    // ReverseOrientation turns the emitting side from −y (counter-clockwise) to +y
+    let rev = scene
+        .lights
+        .iter()
+        .find(|l| l.emission == Vec3::new(1.0, 2.0, 3.0))
+        .unwrap();
+    assert!(matches!(rev.shape, LightShape::Triangle { normal, .. } if close(normal, Vec3::Y)));
+    assert!(!rev.two_sided);
+    let spot = scene.lights.iter().find_map(|l| l.spot).unwrap();
+    assert!(close(spot.direction, Vec3::NEG_Y));
+    assert!((spot.cos_outer - 30f32.to_radians().cos()).abs() < 1e-6);
+    assert!((spot.cos_inner - 20f32.to_radians().cos()).abs() < 1e-6);
+    assert!(close(scene.distant_lights[0].direction, Vec3::Y));
+
+    // what is not supported is a warning with its file and line
+    for (what, line) in [
+        ("LightSource \"infinite\"", 79),
+        ("MakeNamedMedium", 83),
+        ("Shape \"curve\"", 84),
+        ("checkerboard", 10),
+        ("Integrator", 6),
+        ("dielectric rendered as an opaque", 17),
+    ] {
+        assert!(
+            report
+                .warnings
+                .iter()
+                .any(|w| w.contains(what) && w.contains(&format!("scene.pbrt:{line}:"))),
+            "{what} at line {line}: {:#?}",
+            report.warnings
+        );
+    }
+    assert_eq!(scene.stats.warnings, report.warnings);
+}
+
+/// The scene converted to glTF and loaded back: same triangles, lights and materials.
+#[test]
+fn convert_round_trips_through_gltf() {
+    let (scene, _, path) = load_test_scene();
+    let glb = path.with_extension("glb");
+    crate::gltf_writer::write_glb(&scene, &glb).unwrap();
+    let back = crate::gltf_loader::load_gltf(&glb, None).unwrap();
+    assert_eq!(back.triangles.len(), scene.triangles.len());
+    let (a, b) = (&scene.stats, &back.stats);
+    assert_eq!(
+        (
+            a.sphere_lights,
+            a.point_lights,
+            a.spot_lights,
+            a.distant_lights,
+            a.triangle_lights
+        ),
+        (
+            b.sphere_lights,
+            b.point_lights,
+            b.spot_lights,
+            b.distant_lights,
+            b.triangle_lights
+        )
+    );
+    assert!((a.total_power_w - b.total_power_w).abs() < 1e-4 * a.total_power_w);
+    let bunny = back.materials.iter().find(|m| m.name == "bunny").unwrap();
+    assert_eq!(
+        bunny.model,
+        Model::PbrtPlastic {
+            ks: Vec3::splat(0.7),
+            alpha: 0.008
+        }
+    );
+    let walls = back.materials.iter().find(|m| m.name == "walls").unwrap();
+    assert_eq!(walls.params_at(Vec2::ZERO).specular, Specular::None);
+    let (c0, c1) = (scene.camera(None).unwrap(), back.camera(None).unwrap());
+    assert!(
+        close(c0.position, c1.position) && close(c0.forward, c1.forward) && close(c0.up, c1.up)
+    );
+}
+
+fn error_of(files: &[(&str, &str)]) -> String {
+    let d = dir(&format!("err-{}", files[0].1.len() + files.len()));
+    for (name, text) in files {
+        write(&d, name, text);
+    }
+    match load_pbrt(&d.join(files[0].0), None) {
+        Ok(_) => panic!("{files:?} loaded"),
+        Err(e) => e.to_string(),
+    }
+}
+
+/// Malformed input: one message naming the file and line, never a panic.
+#[test]
+fn malformed_input_is_one_error_with_file_and_line() {
+    let shape = "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n";
+    let cases: Vec<(Vec<(&str, String)>, &str)> = vec![
+        (vec![("a.pbrt", format!("{shape}Shape \"sphere\" \"float radius\" \"big\n"))], "a.pbrt:2: unterminated string"),
+        (vec![("b.pbrt", format!("{shape}\nShape \"sphere\" \"float radius\" \"big\"\n"))], "b.pbrt:3: parameter \"float radius\": a `float` cannot hold strings"),
+        (vec![("c.pbrt", format!("{shape}Material \"matte\" \"rgb Kd\" [ 0.1 0.2 ]\n"))], "c.pbrt:2: parameter `Kd`: want 3 values, got 2"),
+        (vec![("d.pbrt", format!("{shape}\n\nInclude \"nowhere.pbrt\"\n"))], "d.pbrt:4: cannot open"),
+        (vec![("e.pbrt", format!("{shape}Include \"f.pbrt\"\n")), ("f.pbrt", "\nInclude \"e.pbrt\"\n".into())], "f.pbrt:2: Include cycle"),
+        (vec![("g.pbrt", format!("{shape}Translate 1 2\nWorldEnd\n"))], "g.pbrt:3: Translate expects 3 numbers"),
+        (vec![("h.pbrt", format!("{shape}AttributeEnd\n"))], "h.pbrt:2: AttributeEnd without a matching begin"),
+        (vec![("i.pbrt", format!("{shape}Frobnicate 3\n"))], "i.pbrt:2: unknown directive `Frobnicate`"),
+        (vec![("j.pbrt", "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0] \"integer indices\" [0 1 7]\n".into())], "j.pbrt:1: Shape \"trianglemesh\": trianglemesh: index 7 is past its 3 vertices"),
+        (vec![("k.pbrt", format!("{shape}NamedMaterial \"nothing\"\n"))], "k.pbrt:2: NamedMaterial \"nothing\" is not defined"),
+        (vec![("l.pbrt", format!("{shape}Shape \"plymesh\" \"string filename\" \"missing.ply\"\n"))], "l.pbrt:2: Shape \"plymesh\": cannot open"),
+        (vec![("m.pbrt", format!("{shape}AreaLightSource \"diffuse\" \"rgb L\" [ -1 0 0 ]\n"))], "m.pbrt:2: AreaLightSource: L × scale"),
+        (vec![("n.pbrt", format!("{shape}Shape \"sphere\" \"float radius\" [ 1 \n"))], "n.pbrt:2: parameter \"float radius\": `[` without `]`"),
+        (vec![("o.pbrt", format!("{shape}LookAt 0 0 0  0 0 1  0 0 1\n"))], "o.pbrt:2: LookAt: the up vector"),
+    ];
+    for (files, want) in &cases {
+        let files: Vec<(&str, &str)> = files.iter().map(|(n, t)| (*n, t.as_str())).collect();
+        let e = error_of(&files);
+        assert!(e.contains(want), "want `{want}`, got `{e}`");
+        assert!(!e.contains('\n'), "one line: {e}");
+    }
+}
+
+/// The authors' Cornell box from its own pbrt-v3 files (skipped without ../shared).
+#[test]
+fn bisml_cornell_pbrt_loads_like_its_gltf() {
+    let dir = PathBuf::from(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../../shared/scenes/bisml_cornell"
+    ));
+    if !dir.exists() {
+        eprintln!("skipped: {} is not present", dir.display());
+        return;
+    }
+    let (scene, report) = load_pbrt_with_report(&dir.join("pbrt/scene.pbrt"), None).unwrap();
+    let glb = crate::gltf_loader::load_gltf(&dir.join("bisml_cornell.glb"), None).unwrap();
+    assert_eq!(scene.stats.sphere_lights, 1494);
+    assert_eq!(scene.triangles.len(), glb.triangles.len());
+    assert!(
+        (scene.stats.total_power_w - glb.stats.total_power_w).abs()
+            < 1e-3 * glb.stats.total_power_w
+    );
+    for (a, b) in scene.lights.iter().zip(&glb.lights) {
+        let (
+            LightShape::Sphere {
+                center: ca,
+                radius: ra,
+            },
+            LightShape::Sphere {
+                center: cb,
+                radius: rb,
+            },
+        ) = (&a.shape, &b.shape)
+        else {
+            panic!("sphere lights")
+        };
+        assert!((*ca - *cb).length() < 1e-5 && (ra - rb).abs() < 1e-9);
+        assert!((a.emission - b.emission).abs().max_element() < 1e-3 * b.emission.max_element());
+    }
+    let cam = scene.camera(None).unwrap();
+    let gcam = glb.camera(None).unwrap();
+    assert!(
+        close(cam.position, gcam.position)
+            && close(cam.forward, gcam.forward)
+            && close(cam.up, gcam.up)
+    );
+    assert!(!cam.mirrored && (cam.yfov - gcam.yfov).abs() < 1e-6);
+    assert_eq!((cam.width, cam.height), (1024, 1024));
+    let bunny = scene.materials.iter().find(|m| m.name == "Bunny").unwrap();
+    assert_eq!(
+        bunny.model,
+        Model::PbrtPlastic {
+            ks: Vec3::splat(0.7),
+            alpha: 0.008
+        }
+    );
+    eprintln!("{:#?}", report.warnings);
+}
