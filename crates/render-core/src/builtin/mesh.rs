@@ -220,6 +220,82 @@ impl Mesh {
         })
     }
 
+    /// An icosphere: the regular icosahedron with each face split into 4^`subdivisions`
+    /// triangles, vertices pushed onto the sphere (20·4^s triangles, flat normals so every
+    /// triangle is a planar emitter that faces outward).
+    pub fn icosphere(center: Vec3, radius: f32, subdivisions: u32) -> Mesh {
+        let t = (1.0 + 5f32.sqrt()) / 2.0;
+        let mut corners: Vec<Vec3> = [
+            [-1.0, t, 0.0],
+            [1.0, t, 0.0],
+            [-1.0, -t, 0.0],
+            [1.0, -t, 0.0],
+            [0.0, -1.0, t],
+            [0.0, 1.0, t],
+            [0.0, -1.0, -t],
+            [0.0, 1.0, -t],
+            [t, 0.0, -1.0],
+            [t, 0.0, 1.0],
+            [-t, 0.0, -1.0],
+            [-t, 0.0, 1.0],
+        ]
+        .iter()
+        .map(|c| Vec3::from(*c).normalize())
+        .collect();
+        let mut faces: Vec<[usize; 3]> = vec![
+            [0, 11, 5],
+            [0, 5, 1],
+            [0, 1, 7],
+            [0, 7, 10],
+            [0, 10, 11],
+            [1, 5, 9],
+            [5, 11, 4],
+            [11, 10, 2],
+            [10, 7, 6],
+            [7, 1, 8],
+            [3, 9, 4],
+            [3, 4, 2],
+            [3, 2, 6],
+            [3, 6, 8],
+            [3, 8, 9],
+            [4, 9, 5],
+            [2, 4, 11],
+            [6, 2, 10],
+            [8, 6, 7],
+            [9, 8, 1],
+        ];
+        for _ in 0..subdivisions {
+            // Midpoints are shared by the two faces of an edge, keyed by the sorted edge.
+            let mut midpoints = std::collections::HashMap::new();
+            let mut mid = |a: usize, b: usize, corners: &mut Vec<Vec3>| -> usize {
+                *midpoints.entry((a.min(b), a.max(b))).or_insert_with(|| {
+                    corners.push((corners[a] + corners[b]).normalize());
+                    corners.len() - 1
+                })
+            };
+            let mut next = Vec::with_capacity(faces.len() * 4);
+            for [a, b, c] in faces {
+                let ab = mid(a, b, &mut corners);
+                let bc = mid(b, c, &mut corners);
+                let ca = mid(c, a, &mut corners);
+                next.extend_from_slice(&[[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+            }
+            faces = next;
+        }
+        // Flat shading: three vertices of its own per face, normal = the face's direction.
+        let mut m = Mesh::default();
+        for f in faces {
+            let p = f.map(|i| center + corners[i] * radius);
+            let n = (p[1] - p[0]).cross(p[2] - p[0]).normalize();
+            let base = m.positions.len() as u32;
+            m.positions.extend_from_slice(&p);
+            m.normals.extend_from_slice(&[n; 3]);
+            m.uvs.extend_from_slice(&[Vec2::ZERO; 3]);
+            m.indices.extend_from_slice(&[base, base + 1, base + 2]);
+        }
+        m
+    }
+
     /// A cylinder of `radius` from `base` along the unit `axis` for `height`, with flat caps
     /// when `caps` is set.
     pub fn cylinder(
@@ -349,6 +425,25 @@ mod tests {
             .clone()
             .transformed(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
         assert!(signed_volume(&mirrored) > 0.0 && normals_agree(&mirrored));
+    }
+
+    #[test]
+    fn icosphere_is_closed_outward_and_round() {
+        for s in 0..3u32 {
+            let m = Mesh::icosphere(Vec3::new(1.0, 2.0, 3.0), 0.5, s);
+            assert_eq!(m.triangle_count(), 20 * 4usize.pow(s));
+            assert!(normals_agree(&m));
+            let moved = m
+                .clone()
+                .transformed(Mat4::from_translation(-Vec3::new(1.0, 2.0, 3.0)));
+            let v = signed_volume(&moved);
+            let ball = 4.0 / 3.0 * PI * 0.125;
+            // Inscribed polyhedra: 61 % of the ball at s = 0, closer with each subdivision.
+            assert!(v > 0.6 * ball && v < ball, "s = {s}: {v} vs {ball}");
+            for p in &moved.positions {
+                assert!((p.length() - 0.5).abs() < 1e-5);
+            }
+        }
     }
 
     #[test]

@@ -9,6 +9,7 @@
 mod car;
 mod cornell;
 mod diffuse_quads;
+mod emissive_mesh;
 mod glossy_spheres;
 mod grid;
 mod lamp;
@@ -83,6 +84,22 @@ const SCENES: &[Def] = &[
             key("seed", "0", SEED_HELP),
         ],
         build: diffuse_quads::build,
+    },
+    Def {
+        name: "emissive-mesh",
+        description: "a cloud of small emissive icospheres (triangle lights) over a metal ground with a diffuse sphere and a glossy box",
+        keys: &[
+            key(
+                "lights",
+                "1000",
+                "number of emissive icospheres (20 x 4^subdivisions triangle lights each)",
+            ),
+            key("subdivisions", "1", "icosphere subdivisions, 0 to 3"),
+            key("radius", "0.02", "radius of each icosphere"),
+            key("roughness", "0.2", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: emissive_mesh::build,
     },
     Def {
         name: "car",
@@ -265,6 +282,9 @@ impl Params {
                 }
                 "roughness" => {
                     params.number("roughness", 0.0, 1.0)?;
+                }
+                "subdivisions" => {
+                    params.count("subdivisions", 0, 3)?;
                 }
                 _ => {}
             }

@@ -29,6 +29,7 @@ fn expected_lights(name: &str, n: usize) -> usize {
     match name {
         "diffuse-quads" => 2 * n,
         "car" => n + 6,
+        "emissive-mesh" => 80 * n,
         _ => n,
     }
 }
@@ -87,8 +88,17 @@ fn every_builtin_builds_is_deterministic_and_follows_its_keys() {
                     _ => None,
                 })
                 .collect();
-            assert_eq!(radii.len(), 50, "{name}");
-            assert!(radii.iter().all(|&x| x == 0.0123), "{name}");
+            if r.stats.sphere_lights > 0 {
+                assert_eq!(radii.len(), 50, "{name}");
+                assert!(radii.iter().all(|&x| x == 0.0123), "{name}");
+            } else {
+                // Triangles of emissive spheres: no edge longer than the diameter.
+                assert_eq!(lights_of(&r), expected_lights(name, 50), "{name}");
+                assert!(r.lights.iter().all(|l| {
+                    let (lo, hi) = l.bounds();
+                    (hi - lo).max_element() <= 2.0 * 0.0123
+                }));
+            }
             variants.push(r);
         }
         if has("roughness") {
@@ -199,9 +209,31 @@ fn names_are_unique_and_documented() {
         "cornell",
         "staircase",
         "grid",
+        "emissive-mesh",
     ] {
         assert!(infos.iter().any(|i| i.name == required), "{required}");
     }
+}
+
+#[test]
+fn emissive_mesh_defaults_are_80000_outward_triangles() {
+    let s = load_builtin("builtin:emissive-mesh").unwrap();
+    assert_eq!(s.stats.triangle_lights, 80_000);
+    assert_eq!(s.stats.sphere_lights, 0);
+    // One-sided triangles (the icosphere test checks that they face outward).
+    assert!(
+        s.lights
+            .iter()
+            .all(|l| !l.two_sided && matches!(l.shape, LightShape::Triangle { .. }))
+    );
+    assert!(matches!(
+        err(load_builtin("builtin:emissive-mesh?lights=20000")),
+        SceneError::BadBuiltinParam { .. }
+    ));
+    assert!(matches!(
+        err(load_builtin("builtin:emissive-mesh?subdivisions=4")),
+        SceneError::BadBuiltinParam { .. }
+    ));
 }
 
 #[test]
