@@ -36,7 +36,7 @@ pub struct RenderArgs {
     /// Exposure of the PNG preview in stops.
     #[arg(long, default_value_t = 0.0)]
     pub exposure: f32,
-    /// Render passes until this many seconds are spent.
+    /// Render until this many seconds are spent (checked before each work unit of 256 pixels).
     #[arg(long)]
     pub time_budget: Option<f64>,
     /// What --time-budget counts: wall time, or the process's CPU time per worker thread
@@ -250,6 +250,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
 
+    if result.unsampled_pixels() > 0 {
+        eprintln!(
+            "warning: the time budget ran out inside the first pass: {} of {} pixels have no sample and are black",
+            result.unsampled_pixels(),
+            result.pixels.len()
+        );
+    }
     write_exr(&args.out, width, height, &result.pixels).map_err(anyhow::Error::msg)?;
     if let Some(p) = &args.png {
         write_png(p, width, height, &result.pixels, args.exposure).map_err(anyhow::Error::msg)?;
@@ -288,6 +295,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "strategy": strategy.name(),
         "strategy_parameters": strategy.parameters(),
         "spp": result.spp,
+        "partial_pass_pixels": result.partial_pixels,
+        "unsampled_pixels": result.unsampled_pixels(),
+        "work_unit_pixels": render_core::render::UNIT_PIXELS,
+        "passes": result.passes,
         "spp_requested": spp,
         "time_budget_s": args.time_budget,
         "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
@@ -311,8 +322,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if args.stats || !args.quiet {
         let secs = result.wall_seconds.max(1e-9);
         eprintln!(
-            "{} spp in {:.2} s ({} passes); closest-hit rays {:.3} M/s, shadow rays {:.3} M/s (whole render, shading included)",
+            "{} spp{} in {:.2} s ({} passes); closest-hit rays {:.3} M/s, shadow rays {:.3} M/s (whole render, shading included)",
             result.spp,
+            if result.partial_pixels > 0 {
+                format!(" + {} pixels of one more", result.partial_pixels)
+            } else {
+                String::new()
+            },
             secs,
             result.passes,
             closest as f64 / secs / 1e6,

@@ -1,9 +1,13 @@
 //! The render loop: camera rays, emission seen directly, one direct-lighting estimate per
-//! camera hit, in progressive passes over bands of rows in parallel.
+//! camera hit, in progressive passes (one sample index each) over work units of at most
+//! [`UNIT_PIXELS`] consecutive pixels, claimed in order by the worker threads.
 //!
-//! Every pixel is owned by one task per pass and its samples are accumulated in sample
-//! order, with random numbers that depend only on (seed, pixel, sample, dimension):
-//! the image is bit-identical whatever the thread count.
+//! Every pixel is owned by one unit per pass and its samples are accumulated in sample
+//! order, with random numbers that depend only on (seed, pixel, sample, dimension): the image
+//! is bit-identical whatever the thread count. A time budget stops the claiming of units, so a
+//! render ends at a boundary (full passes, then the first `partial_pixels` pixels of one more)
+//! that depends on the clock but fully determines the image; the budget is overrun by at most
+//! one unit per thread and one reading of the clock, not by a whole pass.
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::estimator::{DirectLighting, MAX_AUX, PIXEL_MEMORY, SampleContext, ShadingPoint};
@@ -12,11 +16,14 @@ use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
 use crate::stats::Counters;
 use glam::{Vec2, Vec3};
 use host::process_cpu_seconds;
-use rayon::prelude::*;
-use std::time::Instant;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::{Duration, Instant};
 
-/// Rows per parallel task.
-const BAND_ROWS: usize = 4;
+/// Most pixels in one work unit: the granularity at which a time budget can stop a render.
+pub const UNIT_PIXELS: usize = 256;
+/// The process CPU clock (a system call) is read at most this often per thread.
+const CPU_CLOCK_INTERVAL: Duration = Duration::from_millis(5);
 
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
@@ -25,14 +32,14 @@ pub struct RenderSettings {
     /// Samples per pixel; with a time budget, the most that will be taken (`None` = no limit).
     pub spp: Option<u32>,
     pub seed: u64,
-    /// No new pass starts once this budget is spent.
+    /// No new work unit starts once this budget is spent.
     pub time_budget: Option<TimeBudget>,
     /// Worker threads (`None` = all cores).
     pub threads: Option<usize>,
     pub camera: Camera,
 }
 
-/// A render-time limit, checked between passes.
+/// A render-time limit, checked before each work unit.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TimeBudget {
     pub seconds: f64,
@@ -90,7 +97,11 @@ const GIB: f64 = (1u64 << 30) as f64;
 pub struct RenderResult {
     pub width: u32,
     pub height: u32,
+    /// Full passes: every pixel has at least this many samples.
     pub spp: u32,
+    /// Pixels (the first ones in row-major order) with one sample more than `spp`, when a time
+    /// budget stopped the render inside a pass; 0 otherwise.
+    pub partial_pixels: usize,
     /// Mean radiance per pixel, row-major from the top.
     pub pixels: Vec<Vec3>,
     /// Per-pixel variance of the mean (sample variance / spp), per channel.
@@ -102,6 +113,7 @@ pub struct RenderResult {
     pub counters: Counters,
     pub wall_seconds: f64,
     pub cpu_seconds: Option<f64>,
+    /// Passes started, the partial one included.
     pub passes: u32,
     /// Worker threads the passes ran on.
     pub threads: usize,
@@ -112,23 +124,108 @@ impl RenderResult {
     pub fn unlit_mask(&self) -> Vec<bool> {
         self.light_fraction.iter().map(|&f| f == 0.0).collect()
     }
+
+    /// Samples taken at pixel `index` (row-major).
+    pub fn samples_at(&self, index: usize) -> u32 {
+        self.spp + (index < self.partial_pixels) as u32
+    }
+
+    /// Pixels that got no sample at all (a time budget spent inside the first pass): black.
+    pub fn unsampled_pixels(&self) -> usize {
+        if self.spp > 0 {
+            0
+        } else {
+            self.pixels.len() - self.partial_pixels
+        }
+    }
 }
 
-/// Whether `budget` is used up since `start` (wall) / `cpu_start` (process CPU seconds).
-fn budget_spent(
-    budget: &TimeBudget,
+/// Whether a time budget is spent, readable from every worker thread.
+struct BudgetClockReader {
+    budget: TimeBudget,
     start: Instant,
     cpu_start: Option<f64>,
     threads: usize,
-) -> bool {
-    // Reads the CPU clock only when the budget counts it; without one (not a Unix) wall time
-    // stands in rather than never stopping.
-    let cpu_spent = || Some((process_cpu_seconds()? - cpu_start?) / threads.max(1) as f64);
-    let spent = match budget.clock {
-        BudgetClock::Cpu => cpu_spent().unwrap_or_else(|| start.elapsed().as_secs_f64()),
-        BudgetClock::Wall => start.elapsed().as_secs_f64(),
-    };
-    spent >= budget.seconds
+}
+
+impl BudgetClockReader {
+    /// `last_cpu_read`: this thread's last reading of the CPU clock, so that the /proc read
+    /// happens at most every [`CPU_CLOCK_INTERVAL`] per thread.
+    fn spent(&self, last_cpu_read: &mut Option<Instant>) -> bool {
+        let wall = self.start.elapsed().as_secs_f64();
+        match self.budget.clock {
+            BudgetClock::Wall => wall >= self.budget.seconds,
+            BudgetClock::Cpu => {
+                // CPU time per thread never exceeds the wall time: no read needed before then.
+                if wall < self.budget.seconds {
+                    return false;
+                }
+                let now = Instant::now();
+                if last_cpu_read.is_some_and(|t| now - t < CPU_CLOCK_INTERVAL) {
+                    return false;
+                }
+                *last_cpu_read = Some(now);
+                // Without a CPU clock (not a Unix) wall time stands in rather than never stopping.
+                match (process_cpu_seconds(), self.cpu_start) {
+                    (Some(now), Some(start)) => {
+                        (now - start) / self.threads.max(1) as f64 >= self.budget.seconds
+                    }
+                    _ => true,
+                }
+            }
+        }
+    }
+}
+
+/// What every work unit of a render shares.
+struct PassJob<'a> {
+    scene: &'a Scene,
+    strategy: &'a dyn DirectLighting,
+    settings: &'a RenderSettings,
+    aspect: f32,
+    n_aux: usize,
+}
+
+impl PassJob<'_> {
+    /// Sample `sample_index` of the pixels of work unit `u`, accumulated into `unit`.
+    fn render_unit(&self, u: usize, sample_index: u64, unit: &mut [PixelAccum], c: &mut Counters) {
+        let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+        for (i, px) in unit.iter_mut().enumerate() {
+            let index = u * UNIT_PIXELS + i;
+            let (x, y) = (index % w, index / w);
+            let mut rng = SampleStream::new(self.settings.seed, index as u64, sample_index);
+            let jitter = rng.next_2d();
+            let film = Vec2::new(
+                (x as f32 + jitter.x) / w as f32,
+                (y as f32 + jitter.y) / h as f32,
+            );
+            let mut ctx = SampleContext {
+                counters: c,
+                aux: [0.0; MAX_AUX],
+                pixel_memory: &mut px.memory,
+            };
+            let (l, sees_light) = shade_camera_sample(
+                self.scene,
+                self.strategy,
+                &self.settings.camera,
+                self.aspect,
+                film,
+                &mut rng,
+                &mut ctx,
+            );
+            let aux = ctx.aux;
+            // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
+            for k in 0..3 {
+                let v = l[k] as f64;
+                px.sum[k] += v;
+                px.sum_sq[k] += v * v;
+            }
+            px.light_hits += sees_light as u32;
+            for (acc, v) in px.aux.iter_mut().zip(aux).take(self.n_aux) {
+                *acc += v as f64;
+            }
+        }
+    }
 }
 
 /// Camera-ray shading: emission seen directly plus direct lighting at the hit.
@@ -201,7 +298,7 @@ pub fn shading_point(scene: &Scene, hit: SurfaceHit, wo: Vec3) -> Option<Shading
     })
 }
 
-/// Renders `scene` with `strategy`. `progress` is called after each pass with (passes done, spp so far).
+/// Renders `scene` with `strategy`. `progress` is called after each pass with (passes done, full passes so far).
 pub fn render(
     scene: &Scene,
     strategy: &dyn DirectLighting,
@@ -230,90 +327,102 @@ pub fn render(
     let aspect = w as f32 / h as f32;
     let n_aux = strategy.aux_channels().len().min(MAX_AUX);
     let mut accum = vec![PixelAccum::default(); w * h];
+    let threads = pool.current_num_threads();
     let start = Instant::now();
     let cpu_start = process_cpu_seconds();
+    let clock = settings.time_budget.map(|budget| BudgetClockReader {
+        budget,
+        start,
+        cpu_start,
+        threads,
+    });
+    let job = PassJob {
+        scene,
+        strategy,
+        settings,
+        aspect,
+        n_aux,
+    };
     let mut counters = Counters::default();
     let mut spp_done = 0u32;
     let mut passes = 0u32;
+    let mut partial_pixels = 0usize;
+    let stop = AtomicBool::new(false);
     loop {
         if let Some(limit) = settings.spp
             && spp_done >= limit
         {
             break;
         }
-        if let Some(budget) = settings.time_budget
-            && passes > 0
-            && budget_spent(&budget, start, cpu_start, pool.current_num_threads())
-        {
+        if stop.load(Ordering::Relaxed) {
             break;
         }
         let sample_index = spp_done as u64;
-        let pass_counters: Vec<Counters> = pool.install(|| {
-            accum
-                .par_chunks_mut(w * BAND_ROWS)
-                .enumerate()
-                .map(|(band, rows)| {
-                    let mut c = Counters::default();
-                    for (i, px) in rows.iter_mut().enumerate() {
-                        let index = band * BAND_ROWS * w + i;
-                        let (x, y) = (index % w, index / w);
-                        let mut rng = SampleStream::new(settings.seed, index as u64, sample_index);
-                        let jitter = rng.next_2d();
-                        let film = Vec2::new(
-                            (x as f32 + jitter.x) / w as f32,
-                            (y as f32 + jitter.y) / h as f32,
-                        );
-                        let mut ctx = SampleContext {
-                            counters: &mut c,
-                            aux: [0.0; MAX_AUX],
-                            pixel_memory: &mut px.memory,
-                        };
-                        let (l, sees_light) = shade_camera_sample(
-                            scene,
-                            strategy,
-                            &settings.camera,
-                            aspect,
-                            film,
-                            &mut rng,
-                            &mut ctx,
-                        );
-                        let aux = ctx.aux;
-                        // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
-                        for k in 0..3 {
-                            let v = l[k] as f64;
-                            px.sum[k] += v;
-                            px.sum_sq[k] += v * v;
-                        }
-                        px.light_hits += sees_light as u32;
-                        for (acc, v) in px.aux.iter_mut().zip(aux).take(n_aux) {
-                            *acc += v as f64;
-                        }
-                    }
-                    c
-                })
-                .collect()
+        // Units are handed out in order, and every unit claimed is finished: the units done
+        // in this pass are always a prefix of the image.
+        let units: Vec<Mutex<&mut [PixelAccum]>> =
+            accum.chunks_mut(UNIT_PIXELS).map(Mutex::new).collect();
+        let next_unit = AtomicUsize::new(0);
+        let pass_counters: Vec<Counters> = pool.broadcast(|_| {
+            let mut c = Counters::default();
+            let mut last_cpu_read = None;
+            loop {
+                if let Some(clock) = &clock
+                    && (stop.load(Ordering::Relaxed) || clock.spent(&mut last_cpu_read))
+                {
+                    stop.store(true, Ordering::Relaxed);
+                    break;
+                }
+                let u = next_unit.fetch_add(1, Ordering::Relaxed);
+                let Some(unit) = units.get(u) else {
+                    break;
+                };
+                let mut unit = unit.lock().unwrap_or_else(|e| e.into_inner());
+                job.render_unit(u, sample_index, &mut unit, &mut c);
+            }
+            c
         });
         for c in &pass_counters {
             counters.merge(c);
         }
-        spp_done += 1;
+        let mut done = next_unit.load(Ordering::Relaxed).min(units.len());
+        if done == 0 && spp_done == 0 {
+            // A budget spent before the first unit: take that one anyway, so every render has a sample.
+            let mut unit = units[0].lock().unwrap_or_else(|e| e.into_inner());
+            job.render_unit(0, sample_index, &mut unit, &mut counters);
+            done = 1;
+        }
+        if done == 0 {
+            break;
+        }
         passes += 1;
+        if done < units.len() {
+            partial_pixels = done * UNIT_PIXELS;
+            progress(passes, spp_done);
+            break;
+        }
+        spp_done += 1;
         progress(passes, spp_done);
     }
-    let n = spp_done as f64;
+    let samples = |i: usize| (spp_done + (i < partial_pixels) as u32) as f64;
+    let mean = |sum: f64, n: f64| if n > 0.0 { sum / n } else { 0.0 };
     let pixels = accum
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(i, p)| {
+            let n = samples(i);
             Vec3::new(
-                (p.sum[0] / n) as f32,
-                (p.sum[1] / n) as f32,
-                (p.sum[2] / n) as f32,
+                mean(p.sum[0], n) as f32,
+                mean(p.sum[1], n) as f32,
+                mean(p.sum[2], n) as f32,
             )
         })
         .collect();
     let variance_of_mean = accum
         .iter()
-        .map(|p| {
+        .enumerate()
+        .map(|(i, p)| {
+            let n = samples(i);
             let v = |k: usize| {
                 if n < 2.0 {
                     return f32::INFINITY;
@@ -326,7 +435,8 @@ pub fn render(
         .collect();
     let light_fraction = accum
         .iter()
-        .map(|p| (p.light_hits as f64 / n) as f32)
+        .enumerate()
+        .map(|(i, p)| mean(p.light_hits as f64, samples(i)) as f32)
         .collect();
     let aux = strategy
         .aux_channels()
@@ -336,7 +446,11 @@ pub fn render(
         .map(|(k, name)| {
             (
                 name.to_string(),
-                accum.iter().map(|p| (p.aux[k] / n) as f32).collect(),
+                accum
+                    .iter()
+                    .enumerate()
+                    .map(|(i, p)| mean(p.aux[k], samples(i)) as f32)
+                    .collect(),
             )
         })
         .collect();
@@ -349,6 +463,7 @@ pub fn render(
         width: settings.width,
         height: settings.height,
         spp: spp_done,
+        partial_pixels,
         pixels,
         variance_of_mean,
         light_fraction,
@@ -357,6 +472,88 @@ pub fn render(
         wall_seconds,
         cpu_seconds,
         passes,
-        threads: pool.current_num_threads(),
+        threads,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::estimator::ShadingPoint;
+
+    /// One uniformly chosen light, sampled by its shape: cheap, and it uses the random numbers.
+    struct OneLight;
+
+    impl DirectLighting for OneLight {
+        fn name(&self) -> String {
+            "test-one-light".into()
+        }
+
+        fn estimate(
+            &self,
+            scene: &Scene,
+            sp: &ShadingPoint,
+            rng: &mut SampleStream,
+            ctx: &mut SampleContext,
+        ) -> Vec3 {
+            let n = scene.lights.len();
+            let i = ((rng.next_f32() * n as f32) as usize).min(n - 1);
+            match scene.lights[i].sample(sp.point(), rng.next_2d()) {
+                Some(s) => sp.shade(scene, &s, ctx.counters) * n as f32 / s.pdf,
+                None => Vec3::ZERO,
+            }
+        }
+    }
+
+    fn run(scene: &Scene, spp: Option<u32>, budget: Option<f64>, threads: usize) -> RenderResult {
+        let settings = RenderSettings {
+            width: 64,
+            height: 40,
+            spp,
+            seed: 3,
+            time_budget: budget.map(|seconds| TimeBudget {
+                seconds,
+                clock: BudgetClock::Wall,
+            }),
+            threads: Some(threads),
+            camera: scene.camera(None).unwrap(),
+        };
+        render(scene, &OneLight, &settings, &|_, _| {}).unwrap()
+    }
+
+    #[test]
+    fn images_are_identical_for_any_thread_count() {
+        let scene = crate::builtin::load_builtin("builtin:glossy-spheres?lights=64").unwrap();
+        let a = run(&scene, Some(3), None, 1);
+        let b = run(&scene, Some(3), None, 3);
+        assert_eq!((a.spp, a.partial_pixels, b.spp), (3, 0, 3));
+        assert_eq!(a.pixels, b.pixels);
+        assert_eq!(a.variance_of_mean, b.variance_of_mean);
+        assert_eq!(a.counters, b.counters);
+    }
+
+    /// A budget spent at once stops after one work unit, inside the first pass: the render
+    /// ends at a unit boundary, not after a pass over the image, and what it did is exactly
+    /// the start of a fixed-spp render, whatever the thread count.
+    #[test]
+    fn a_budget_ends_at_a_unit_boundary_inside_a_pass() {
+        let scene = crate::builtin::load_builtin("builtin:glossy-spheres?lights=64").unwrap();
+        let full = run(&scene, Some(1), None, 2);
+        let pixels = 64 * 40;
+        assert!(pixels > 4 * UNIT_PIXELS, "the image needs several units");
+        for threads in [1, 3] {
+            let r = run(&scene, None, Some(1e-9), threads);
+            assert_eq!(
+                (r.spp, r.partial_pixels),
+                (0, UNIT_PIXELS),
+                "{threads} threads"
+            );
+            assert_eq!(r.unsampled_pixels(), pixels - UNIT_PIXELS);
+            assert_eq!(r.passes, 1);
+            assert_eq!(r.counters.camera_rays, UNIT_PIXELS as u64);
+            assert_eq!(r.pixels[..UNIT_PIXELS], full.pixels[..UNIT_PIXELS]);
+            assert!(r.pixels[UNIT_PIXELS..].iter().all(|p| *p == Vec3::ZERO));
+            assert_eq!((r.samples_at(0), r.samples_at(UNIT_PIXELS)), (1, 0));
+        }
+    }
 }
