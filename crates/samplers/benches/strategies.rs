@@ -66,7 +66,7 @@ fn bench_strategies(c: &mut Criterion) {
             .warm_up_time(Duration::from_millis(300))
             .measurement_time(Duration::from_secs(1))
             .throughput(Throughput::Elements(points.len() as u64));
-        for info in samplers::strategies().into_iter().filter(|s| s.implemented) {
+        for info in samplers::strategies() {
             let strategy = samplers::create(info.name, &scene, &options).unwrap();
             g.bench_function(info.name, |b| {
                 let mut counters = Counters::default();
