@@ -40,8 +40,8 @@ pub fn material(name: &str, kd: Vec3, ks: Vec3, roughness: f32, remap_roughness:
 mod tests {
     use super::*;
     use crate::bsdf::Bsdf;
-    use chi2_test::{chi2_directions, sidak_significance};
     use crate::rng::SampleStream;
+    use chi2_test::{chi2_directions, sidak_significance};
     use glam::Vec2;
     use std::f64::consts::PI;
 

@@ -1,12 +1,20 @@
 //! Walker/Vose alias table: O(1) sampling of a discrete distribution.
 
+/// One bin: everything a draw reads, in one 16-byte record, so that a draw touches one cache
+/// line of a table far larger than the cache (80,000 lights: 1.3 MB).
+#[derive(Clone, Copy, Debug)]
+struct Bin {
+    /// Probability of keeping the bin (else its alias).
+    keep: f32,
+    alias: u32,
+    /// Normalised probabilities of the bin's own index and of its alias.
+    pmf: f32,
+    alias_pmf: f32,
+}
+
 #[derive(Clone, Debug)]
 pub struct AliasTable {
-    /// Probability of keeping bin i (else take `alias[i]`).
-    keep: Vec<f32>,
-    alias: Vec<u32>,
-    /// Normalised probabilities, for `pmf`.
-    pmf: Vec<f32>,
+    bins: Vec<Bin>,
 }
 
 impl AliasTable {
@@ -39,33 +47,43 @@ impl AliasTable {
             }
         }
         // Leftovers are 1 up to rounding.
-        Some(AliasTable { keep, alias, pmf })
+        let bins = (0..n)
+            .map(|i| Bin {
+                keep: keep[i],
+                alias: alias[i],
+                pmf: pmf[i],
+                alias_pmf: pmf[alias[i] as usize],
+            })
+            .collect();
+        Some(AliasTable { bins })
     }
 
     pub fn len(&self) -> usize {
-        self.pmf.len()
+        self.bins.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.pmf.is_empty()
+        self.bins.is_empty()
     }
 
     /// Index and its probability from one uniform number.
+    #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
-        let n = self.pmf.len();
+        let n = self.bins.len();
         let x = u * n as f32;
         let i = (x as usize).min(n - 1);
         let frac = x - i as f32;
-        let k = if frac < self.keep[i] {
-            i
+        let bin = &self.bins[i];
+        if frac < bin.keep {
+            (i, bin.pmf)
         } else {
-            self.alias[i] as usize
-        };
-        (k, self.pmf[k])
+            (bin.alias as usize, bin.alias_pmf)
+        }
     }
 
+    #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
-        self.pmf[i]
+        self.bins[i].pmf
     }
 }
 

@@ -9,12 +9,19 @@ use render_core::light::LightSample;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
+use std::cell::RefCell;
 
 pub struct LightStrategy<S: LightSelection> {
     pub name: String,
     pub selection: S,
     pub with_bsdf: bool,
     pub parameters: serde_json::Value,
+}
+
+thread_local! {
+    /// The picks of one shading point, reused by every sample the thread draws: no heap
+    /// allocation per sample.
+    static PICKS: RefCell<Vec<(u32, f32)>> = const { RefCell::new(Vec::new()) };
 }
 
 pub const TECHNIQUE_LIGHT: usize = 0;
@@ -31,7 +38,7 @@ pub(crate) fn sample_pick(
     counters: &mut Counters,
 ) -> Option<(LightSample, f32, Vec3)> {
     let u = rng.next_2d();
-    let s = scene.lights[light as usize].sample(sp.point(), u)?;
+    let s = scene.sample_light(light, sp.point(), u)?;
     let p = pmf * s.pdf;
     if !(p > 0.0) {
         return None;
@@ -65,23 +72,25 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let state = self.selection.prepare(scene, sp);
-        let mut picks = Vec::new();
-        self.selection.pick(&state, sp, rng, &mut picks);
         let x = sp.point();
         let mut l = Vec3::ZERO;
-        for &(light, pmf) in &picks {
-            ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
-            let Some((s, p_light, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters)
-            else {
-                continue;
-            };
-            let w = if self.with_bsdf && !s.is_delta {
-                power2(p_light, sp.bsdf.pdf(sp.wo, s.wi))
-            } else {
-                1.0
-            };
-            l += f * (w / p_light);
-        }
+        PICKS.with_borrow_mut(|picks| {
+            picks.clear();
+            self.selection.pick(&state, sp, rng, picks);
+            for &(light, pmf) in picks.iter() {
+                ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
+                let Some((s, p_light, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters)
+                else {
+                    continue;
+                };
+                let w = if self.with_bsdf && !s.is_delta {
+                    power2(p_light, sp.bsdf.pdf(sp.wo, s.wi))
+                } else {
+                    1.0
+                };
+                l += f * (w / p_light);
+            }
+        });
         if self.with_bsdf {
             ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
             if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)
