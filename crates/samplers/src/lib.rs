@@ -13,6 +13,8 @@ pub mod bsdf_sampling;
 pub mod convergence;
 pub mod light_strategy;
 pub mod mis;
+pub mod oracle;
+pub mod ris;
 pub mod selection;
 pub mod tree_selection;
 
@@ -122,6 +124,20 @@ pub fn strategies() -> Vec<StrategyInfo> {
             "mis3-adaptive",
             "Liu et al. 2019: three-technique MIS with adaptive allocation",
         ),
+        s(
+            "oracle",
+            "every light's unshadowed contribution per point, one light chosen ∝ it (+5 % power), + BSDF sampling, MIS: a floor, O(lights) per point",
+        ),
+        s(
+            "ris",
+            "resampled importance sampling: 8 light-tree + BO candidates, one kept, + BSDF sampling, MIS (ris-N: N candidates)",
+        ),
+        s("ris-4", "ris with 4 candidates"),
+        s("ris-32", "ris with 32 candidates"),
+        s(
+            "ris-adaptive",
+            "ris with 4 + round(28·UB) candidates (UB of the BO cut, the paper's heuristic 1)",
+        ),
     ]
 }
 
@@ -188,6 +204,16 @@ pub fn create(
         }),
         "bsdf" => Box::new(BsdfStrategy),
         "brdf-oriented" | "mis3-equal" | "mis3-adaptive" => mis3(name, scene, opts)?,
+        "oracle" => Box::new(LightStrategy {
+            name: name.into(),
+            selection: oracle::OracleSelection::new(scene),
+            with_bsdf: true,
+            parameters: serde_json::json!({
+                "defensive_power_fraction": oracle::DEFENSIVE,
+                "strata_per_side": oracle::STRATA_PER_SIDE,
+            }),
+        }),
+        other if ris_count(other).is_some() => ris(name, ris_count(other).unwrap(), scene, opts)?,
         other => {
             return Err(StrategyError::Unknown {
                 name: other.into(),
@@ -275,5 +301,49 @@ fn mis3(
                 config,
             })
         }
+    })
+}
+
+/// Candidate count of a `ris` strategy name: `ris` (8), `ris-N` (1 ≤ N ≤ 1024), `ris-adaptive`.
+fn ris_count(name: &str) -> Option<ris::CandidateCount> {
+    use ris::CandidateCount;
+    match name {
+        "ris" => Some(CandidateCount::Fixed(8)),
+        "ris-adaptive" => Some(CandidateCount::Adaptive { min: 4, max: 32 }),
+        _ => {
+            let m: u32 = name.strip_prefix("ris-")?.parse().ok()?;
+            (1..=1024).contains(&m).then_some(CandidateCount::Fixed(m))
+        }
+    }
+}
+
+/// The RIS strategies (see [`ris`]); the BO candidates use the BO cut of `mis3` with its options.
+fn ris(
+    name: &str,
+    count: ris::CandidateCount,
+    scene: &Scene,
+    opts: &StrategyOptions,
+) -> Result<Box<dyn DirectLighting>, StrategyError> {
+    use brdf_oriented::BrdfIntegral;
+    let tree = TreeSelection::new(scene, TreeMode::Single)
+        .map_err(StrategyError::BadOption)?
+        .tree;
+    Ok(match opts.brdf_integral {
+        BrdfIntegral::Sptd => Box::new(ris::strategy::Ris {
+            name: name.into(),
+            tree,
+            integral: brdf_integrals::Sptd::default(),
+            count,
+            delta: opts.delta,
+            max_cut: opts.max_cut,
+        }),
+        BrdfIntegral::Ltc => Box::new(ris::strategy::Ris {
+            name: name.into(),
+            tree,
+            integral: brdf_integrals::Ltc::default(),
+            count,
+            delta: opts.delta,
+            max_cut: opts.max_cut,
+        }),
     })
 }

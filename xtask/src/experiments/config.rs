@@ -137,6 +137,14 @@ pub struct StrategyEntry {
     /// Extra raw flags.
     #[serde(default)]
     pub args: Vec<String>,
+    /// Render at the experiment's time budgets too (default); `false` for a strategy measured at
+    /// equal spp only (the O(lights)-per-point oracle, too slow for equal time by design).
+    #[serde(default = "yes")]
+    pub equal_time: bool,
+}
+
+fn yes() -> bool {
+    true
 }
 
 impl StrategyEntry {

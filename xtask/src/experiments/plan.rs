@@ -154,6 +154,9 @@ pub fn expand(exp: &Experiment) -> Vec<Cell> {
         let (width, height) = scene_resolution(exp, scene);
         for budget in &budgets {
             for strategy in &exp.strategies {
+                if matches!(budget, Budget::Time(_)) && !strategy.equal_time {
+                    continue;
+                }
                 for &seed in &exp.seeds {
                     cells.push(Cell {
                         scene: scene.clone(),

@@ -358,3 +358,64 @@ mod tests {
         assert!(format_time_table(&rows, &cols, &m).contains("| s | 1.50 s / 16 spp |"));
     }
 }
+
+/// Each strategy's relMSE as a multiple of the `oracle` column's in the same row (same scene and
+/// spp): how far each is from the best light selection at equal samples. Same layout as
+/// [`format_table`], without the oracle column itself.
+pub fn format_oracle_table(
+    rows: &[String],
+    cols: &[String],
+    entries: &BTreeMap<(String, String), Entry>,
+    oracle: &str,
+) -> String {
+    let others: Vec<&String> = cols.iter().filter(|c| c.as_str() != oracle).collect();
+    let mut s = String::from("| scene |");
+    for c in &others {
+        let _ = write!(s, " {c} |");
+    }
+    s.push_str("\n|---|");
+    for _ in &others {
+        s.push_str("---:|");
+    }
+    s.push('\n');
+    for r in rows {
+        let _ = write!(s, "| {r} |");
+        let base = entries
+            .get(&(r.clone(), oracle.to_string()))
+            .map(|e| e.error.mean);
+        for c in &others {
+            match (entries.get(&(r.clone(), (*c).clone())), base) {
+                (Some(e), Some(o)) if o > 0.0 => {
+                    let _ = write!(s, " {:.2}× |", e.error.mean / o);
+                }
+                _ => s.push_str(" – |"),
+            }
+        }
+        s.push('\n');
+    }
+    s
+}
+
+#[cfg(test)]
+mod oracle_table_tests {
+    use super::*;
+
+    #[test]
+    fn multiples_of_the_oracle_per_row() {
+        let e = |m: f64| Entry {
+            error: Stat::of(&[m]),
+            seconds: 1.0,
+            spp: 4.0,
+        };
+        let mut g = BTreeMap::new();
+        g.insert(("s".to_string(), "A".to_string()), e(0.3));
+        g.insert(("s".to_string(), "O".to_string()), e(0.1));
+        g.insert(("t".to_string(), "A".to_string()), e(0.2));
+        let rows = vec!["s".to_string(), "t".to_string()];
+        let cols = vec!["A".to_string(), "O".to_string()];
+        let md = format_oracle_table(&rows, &cols, &g, "O");
+        assert!(md.starts_with("| scene | A |\n|---|---:|\n"), "{md}");
+        assert!(md.contains("| s | 3.00× |"), "{md}");
+        assert!(md.contains("| t | – |"), "{md}");
+    }
+}

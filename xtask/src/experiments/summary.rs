@@ -113,6 +113,7 @@ pub fn generate(
     let mut md = String::new();
     write_header(&mut md, &layout, &cells);
     write_error_tables(&mut md, &layout, &cells, Pixels::Unlit);
+    write_oracle_tables(&mut md, &layout, &cells);
     write_error_tables(&mut md, &layout, &cells, Pixels::All);
     write_time_tables(&mut md, &layout, &cells);
     write_figures(&mut md, &layout, &cells, out, refs_dir)?;
@@ -216,6 +217,42 @@ fn write_error_tables(md: &mut String, layout: &Layout, cells: &[CellResult], pi
             layout.baseline(),
             budget,
             &layout.ref_noise,
+        ));
+        md.push('\n');
+    }
+}
+
+/// Where the experiment has an `oracle` strategy: each strategy's relMSE (unlit pixels) as a
+/// multiple of the oracle's at the same spp (see [`report::format_oracle_table`]).
+fn write_oracle_tables(md: &mut String, layout: &Layout, cells: &[CellResult]) {
+    let Some(oracle) = layout
+        .exp
+        .strategies
+        .iter()
+        .find(|s| s.name == "oracle" && layout.cols.contains(&s.label))
+    else {
+        return;
+    };
+    for budget in layout
+        .budgets
+        .iter()
+        .filter(|b| matches!(b, Budget::Spp(_)))
+    {
+        let g = grid(cells, budget, Pixels::Unlit, layout.clock());
+        if !g.keys().any(|(_, c)| c == &oracle.label) {
+            continue;
+        }
+        let _ = writeln!(
+            md,
+            "## relMSE as a multiple of `{}`'s, {}\n",
+            oracle.label,
+            budget.describe()
+        );
+        md.push_str(&report::format_oracle_table(
+            &layout.rows,
+            &layout.cols,
+            &g,
+            &oracle.label,
         ));
         md.push('\n');
     }

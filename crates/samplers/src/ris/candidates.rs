@@ -1,0 +1,158 @@
+//! The RIS candidate source at one shading point: `n_ls` candidates from a single light-tree
+//! descent (LS) and `n_bo` from BRDF-oriented sampling (BO), each a light point drawn by the
+//! technique's own point sampling; and, side by side, the density of any light point under
+//! every candidate slot, Σ_j p_{s(j)}(y) = n_ls·p_LS(y) + n_bo·p_BO(y).
+//!
+//! Cost: the tree importances of LS are memoised per shading point like BO's, so the second
+//! technique's density at a candidate (a replay down the same few tree levels) costs lookups.
+use crate::brdf_oriented::importance::LobeDensity;
+use crate::brdf_oriented::technique::BoState;
+use brdf_integrals::LobeIntegral;
+use light_tree::{LightTree, NodeId, Rescaled};
+use render_core::Vec3;
+use render_core::estimator::ShadingPoint;
+use render_core::light::LightSample;
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+use std::cell::RefCell;
+
+const MEMO_SIZE: usize = 1024;
+
+/// Direct-mapped cache of the tree's importance at one shading point (pure function of the
+/// node, so a hit is bit-identical to a recomputation and sampling and replay agree).
+struct TreeMemo {
+    slots: RefCell<Vec<(NodeId, f32)>>,
+}
+
+pub struct CandidateSource<'a, L> {
+    scene: &'a Scene,
+    tree: &'a LightTree,
+    x: Vec3,
+    n: Vec3,
+    memo: TreeMemo,
+    bo: Option<&'a BoState<L>>,
+    pub n_ls: u32,
+    pub n_bo: u32,
+}
+
+/// A drawn light point and the technique's selection probability of its light.
+pub struct Drawn {
+    pub light: u32,
+    pub sample: LightSample,
+}
+
+impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
+    /// `m` candidates: half (rounded down) from BO when the point has a BO state, the rest LS.
+    pub fn new(
+        scene: &'a Scene,
+        tree: &'a LightTree,
+        sp: &ShadingPoint,
+        bo: Option<&'a BoState<L>>,
+        m: u32,
+    ) -> Self {
+        let n_bo = if bo.is_some() { m / 2 } else { 0 };
+        CandidateSource {
+            scene,
+            tree,
+            x: sp.point(),
+            n: sp.bsdf.ng,
+            memo: TreeMemo {
+                slots: RefCell::new(vec![(NodeId::MAX, 0.0); MEMO_SIZE]),
+            },
+            bo,
+            n_ls: m - n_bo,
+            n_bo,
+        }
+    }
+
+    pub fn count(&self) -> u32 {
+        self.n_ls + self.n_bo
+    }
+
+    fn tree_importance(&self, id: NodeId) -> f32 {
+        let slot = (id.wrapping_mul(0x9E37_79B1) >> 22) as usize % MEMO_SIZE;
+        if let Some(&(k, v)) = self.memo.slots.borrow().get(slot)
+            && k == id
+        {
+            return v;
+        }
+        let v = self.tree.importance(id, self.x, self.n);
+        self.memo.slots.borrow_mut()[slot] = (id, v);
+        v
+    }
+
+    /// LS selection probability of `light` (a single descent under the tree importance).
+    pub fn ls_pmf(&self, light: u32) -> f32 {
+        self.tree.pmf_subtree(
+            self.tree.root(),
+            |c| self.tree_importance(c),
+            light as usize,
+        )
+    }
+
+    /// Draws candidate slot `j` (LS for j < n_ls, BO after); `None` when the technique finds
+    /// nothing (a dead end, or a point that emits nothing towards x): a candidate of weight 0.
+    pub fn sample(&self, j: u32, rng: &mut SampleStream) -> Option<Drawn> {
+        if j < self.n_ls {
+            let u = rng.next_f32();
+            let (light, _) = self.tree.sample_subtree(
+                self.tree.root(),
+                |c| self.tree_importance(c),
+                &mut Rescaled(u),
+            )?;
+            let sample = self.scene.lights[light].sample(self.x, rng.next_2d())?;
+            Some(Drawn {
+                light: light as u32,
+                sample,
+            })
+        } else {
+            let bo = self.bo?;
+            let (light, _) = bo.select(self.tree, rng, true)?;
+            let sample = bo.sample_point(&self.scene.lights[light], rng)?;
+            Some(Drawn {
+                light: light as u32,
+                sample,
+            })
+        }
+    }
+
+    /// LS density of a light point (solid angle; the selection probability alone for a delta light).
+    pub fn ls_pdf(&self, light: u32, point: Vec3, normal: Vec3, delta: bool) -> f32 {
+        let p_sel = self.ls_pmf(light);
+        if delta || !(p_sel > 0.0) {
+            return p_sel;
+        }
+        p_sel * self.scene.lights[light as usize].pdf(self.x, point, normal)
+    }
+
+    /// BO density of a light point (0 without a BO state).
+    pub fn bo_pdf(&self, light: u32, point: Vec3, normal: Vec3, wi: Vec3) -> f32 {
+        let Some(bo) = self.bo else { return 0.0 };
+        let p_sel = bo.selection_pmf(self.tree, light as usize);
+        if !(p_sel > 0.0) {
+            return 0.0;
+        }
+        p_sel * bo.point_pdf(&self.scene.lights[light as usize], point, normal, wi)
+    }
+
+    /// Σ over the candidate slots of their source densities at a light point:
+    /// n_ls·p_LS + n_bo·p_BO. The mixture density is this over [`CandidateSource::count`].
+    pub fn pdf_sum(&self, light: u32, point: Vec3, normal: Vec3, wi: Vec3, delta: bool) -> f32 {
+        let ls = self.ls_pdf(light, point, normal, delta);
+        let bo = if self.n_bo > 0 {
+            self.bo_pdf(light, point, normal, wi)
+        } else {
+            0.0
+        };
+        self.n_ls as f32 * ls + self.n_bo as f32 * bo
+    }
+
+    /// The mixture density of one candidate slot drawn at random among all slots.
+    pub fn mixture_pdf(&self, light: u32, point: Vec3, normal: Vec3, wi: Vec3, delta: bool) -> f32 {
+        let m = self.count();
+        if m == 0 {
+            return 0.0;
+        }
+        self.pdf_sum(light, point, normal, wi, delta) / m as f32
+    }
+}

@@ -1,0 +1,177 @@
+//! The RIS strategies: per shading point, M candidates from the LS + BO mixture, each weighted
+//! by the unshadowed contribution over the candidates' source densities, one kept and
+//! shadow-tested; plus one BSDF sample, combined by MIS.
+//!
+//! **Estimator.** With target p̂(y) = luminance of the unshadowed f·L·G and Σ_j p_{s(j)}(y) the
+//! sum of the M slots' source densities ([`CandidateSource::pdf_sum`]), candidate i gets
+//! w_i = p̂(y_i) / Σ_j p_{s(j)}(y_i) (RIS with balance-heuristic weights across the slots), one
+//! is kept with probability w_i / W, W = Σ w_i, and the estimate of ∫ g is g(y)·W / p̂(y).
+//! Given the candidates its expectation is Σ_i g(y_i) / Σ_j p_{s(j)}(y_i), whose expectation
+//! over the independent y_i ~ p_{s(i)} is ∫ g over the union of the sources' supports — for any
+//! g that is a fixed function of y and zero where p̂ is zero.
+//!
+//! **MIS with BSDF sampling.** RIS has no tractable density, so it is not weighed by its own
+//! density. The two techniques estimate complementary parts of the integrand instead:
+//! RIS estimates ∫ w_R·f and BSDF sampling ∫ w_B·f, with w_R(y) = power heuristic of the
+//! candidate *mixture* density p_mix(y) = Σ_j p_{s(j)}(y)/M against the BSDF density, and
+//! w_B = 1 − w_R (the same heuristic from the other side; delta lights: w_R = 1). Both weights
+//! are fixed functions of y and the shading point (M is fixed per point before drawing), so
+//! g = w_R·f is a valid RIS integrand and the two estimates sum to ∫ f wherever either
+//! technique can reach y: where p_mix = 0, w_R = 0 and BSDF sampling takes it all. A weight
+//! that used the candidates (e.g. a density estimated from W) would make g depend on them and
+//! break the argument. p_mix understates how concentrated the kept candidate is, so the split
+//! leans towards BSDF sampling on sharp lobes, which is where it is strong anyway.
+use super::CandidateCount;
+use super::candidates::CandidateSource;
+use super::resample;
+use crate::brdf_oriented::LobePivot;
+use crate::brdf_oriented::importance::{BoRecord, LobeDensity};
+use crate::brdf_oriented::technique::BoState;
+use crate::bsdf_sampling::sample_bsdf;
+use crate::mis::power2;
+use brdf_integrals::CapIntegral;
+use light_tree::LightTree;
+use render_core::Vec3;
+use render_core::colour::luminance;
+use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
+use render_core::light::LightSample;
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+
+pub const TECHNIQUE_CANDIDATES: usize = 0;
+pub const TECHNIQUE_RIS: usize = 1;
+pub const TECHNIQUE_BSDF: usize = 2;
+
+pub struct Ris<C: CapIntegral> {
+    pub name: String,
+    pub tree: Option<LightTree>,
+    pub integral: C,
+    pub count: CandidateCount,
+    /// BO cut: split threshold δ and most clusters.
+    pub delta: f32,
+    pub max_cut: usize,
+}
+
+struct Candidate {
+    light: u32,
+    sample: LightSample,
+    target: f32,
+}
+
+impl<C: CapIntegral> Ris<C>
+where
+    C::Lobe: LobePivot + LobeDensity,
+{
+    /// The BO state of a point (none on pure diffuse points, as in `mis3`).
+    pub fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<C::Lobe>> {
+        let tree = self.tree.as_ref()?;
+        if sp.bsdf.is_pure_diffuse() {
+            return None;
+        }
+        let lobe = self
+            .integral
+            .lobe(sp.bsdf.frame.to_local(sp.wo), sp.bsdf.params.alpha);
+        let rec = BoRecord::new(sp, lobe, true, false);
+        Some(BoState::new(tree, rec, self.delta, self.max_cut, None))
+    }
+}
+
+impl<C: CapIntegral> DirectLighting for Ris<C>
+where
+    C::Lobe: LobePivot + LobeDensity,
+{
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        serde_json::json!({
+            "candidates": self.count,
+            "delta": self.delta,
+            "max_cut": self.max_cut,
+        })
+    }
+
+    fn techniques(&self) -> Vec<&'static str> {
+        vec!["candidates", "ris", "bsdf"]
+    }
+
+    fn aux_channels(&self) -> Vec<&'static str> {
+        vec!["candidates"]
+    }
+
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let Some(tree) = self.tree.as_ref() else {
+            return Vec3::ZERO;
+        };
+        let bo = self.bo_state(sp);
+        let m = self
+            .count
+            .at(bo.as_ref().map_or(0.0, |b| b.cut.upper_bound()));
+        let source = CandidateSource::new(scene, tree, sp, bo.as_ref(), m);
+        ctx.aux[0] = m as f32;
+
+        // Candidates and their resampling weights.
+        let mut candidates: Vec<Candidate> = Vec::with_capacity(m as usize);
+        let mut weights: Vec<f32> = Vec::with_capacity(m as usize);
+        for j in 0..m {
+            ctx.counters.technique_samples[TECHNIQUE_CANDIDATES] += 1;
+            let Some(d) = source.sample(j, rng) else {
+                continue;
+            };
+            let s = d.sample;
+            let target = luminance(sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance);
+            if !(target > 0.0) || !target.is_finite() {
+                continue;
+            }
+            let den = source.pdf_sum(d.light, s.point, s.normal, s.wi, s.is_delta);
+            if !(den > 0.0) {
+                continue;
+            }
+            let w = target / den;
+            if w.is_finite() {
+                candidates.push(Candidate {
+                    light: d.light,
+                    sample: s,
+                    target,
+                });
+                weights.push(w);
+            }
+        }
+
+        let mut l = Vec3::ZERO;
+        // The kept candidate: one shadow ray.
+        let u = rng.next_f32();
+        if let Some((k, total)) = resample::pick(&weights, u) {
+            ctx.counters.technique_samples[TECHNIQUE_RIS] += 1;
+            let c = &candidates[k];
+            let s = &c.sample;
+            let f = sp.shade(scene, s, ctx.counters);
+            if f != Vec3::ZERO {
+                let w_ris = if s.is_delta {
+                    1.0
+                } else {
+                    let p_mix = source.mixture_pdf(c.light, s.point, s.normal, s.wi, false);
+                    power2(p_mix, sp.bsdf.pdf(sp.wo, s.wi))
+                };
+                l += f * (w_ris * total / c.target);
+            }
+        }
+
+        // BSDF sampling, weighted by the complement of the RIS weight at the point it finds.
+        ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
+        if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)
+            && b.found_light()
+        {
+            let p_mix = source.mixture_pdf(b.light, b.point, b.normal, b.wi, false);
+            l += b.f_cos * b.radiance * (power2(b.pdf, p_mix) / b.pdf);
+        }
+        l
+    }
+}
