@@ -1,14 +1,19 @@
 //! Project automation (the `cargo xtask` pattern). Subcommands are added by the issues that need them.
 mod contact_sheet;
 mod experiments;
+mod fuzz;
 mod glossy_mask;
+
+/// Counts allocations for `fuzz` (a case may not allocate more than its file can describe).
+#[global_allocator]
+static ALLOCATOR: scene_fuzz::CountingAllocator = scene_fuzz::CountingAllocator;
 
 fn main() -> std::process::ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  glossy-mask SCENE W H OUT.png [--max-alpha A]    mask of the pixels whose camera ray sees GGX α < A"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  fuzz [--minutes N] [--seed S] [--case K]    fuzz the scene loaders (crates/scene-fuzz) for N minutes\n  glossy-mask SCENE W H OUT.png [--max-alpha A]    mask of the pixels whose camera ray sees GGX α < A"
             );
         }
         Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
@@ -30,6 +35,7 @@ fn main() -> std::process::ExitCode {
         // issue 7: every scene on one sheet
         Some("contact-sheet") => return contact_sheet::main(&args),
         Some("glossy-mask") => return glossy_mask::main(&args),
+        Some("fuzz") => return fuzz::main(&args),
         Some(other) => {
             eprintln!("error: unknown xtask command `{other}` (try `cargo xtask help`)");
             std::process::exit(2);

@@ -207,7 +207,16 @@ fn bad_input_fails_cleanly() {
         a.extend_from_slice(extra);
         a.iter().map(|s| s.to_string()).collect::<Vec<_>>()
     };
+    let huge: Vec<String> = [
+        "render", SCENE, "--spp", "1", "--width", "100000", "--height", "100000", "--quiet",
+        "--out", out,
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
     let cases: Vec<(Vec<String>, &str)> = vec![
+        // refused from the memory estimate, before anything is allocated
+        (huge, "100000×100000 render needs about"),
         (r(missing.to_str().unwrap(), &[]), "missing.gltf"),
         (r(garbage.to_str().unwrap(), &[]), "garbage.glb"),
         (

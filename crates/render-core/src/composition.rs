@@ -177,10 +177,12 @@ fn bad(path: &Path, message: impl Into<String>) -> SceneError {
 
 /// Loads a composition file.
 pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|e| SceneError::Io {
+    let io = |message: String| SceneError::Io {
         path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+        message,
+    };
+    crate::gltf_loader::regular_file(path).map_err(io)?;
+    let text = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
     let comp: Composition = toml::from_str(&text).map_err(|e| {
         // toml's message spans several lines (location, excerpt, reason): keep it on one.
         let text = e.to_string();

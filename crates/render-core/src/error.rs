@@ -18,8 +18,10 @@ pub enum SceneError {
     Composition { path: String, message: String },
     #[error("scene has no triangles and no lights")]
     Empty,
-    #[error("non-finite vertex position in mesh `{mesh}`")]
+    #[error("non-finite vertex position in mesh `{mesh}` (or beyond ±1e18 after its transform)")]
     NonFiniteVertex { mesh: String },
+    #[error("invalid material `{name}`: {message}")]
+    BadMaterial { name: String, message: String },
     #[error("invalid emission in {what}: {value} (must be finite and non-negative)")]
     BadEmission { what: String, value: String },
     #[error("invalid light `{what}`: {message}")]

@@ -158,10 +158,12 @@ pub fn add_gltf(
     path: &Path,
     transform: Mat4,
 ) -> Result<GltfReport, SceneError> {
-    let bytes = std::fs::read(path).map_err(|e| SceneError::Io {
+    let io = |e: String| SceneError::Io {
         path: path.display().to_string(),
-        message: e.to_string(),
-    })?;
+        message: e,
+    };
+    regular_file(path).map_err(io)?;
+    let bytes = std::fs::read(path).map_err(|e| io(e.to_string()))?;
     // Check the required extensions first, so an unsupported one gets its own message
     // instead of a validation report.
     let raw = gltf::Gltf::from_slice_without_validation(&bytes)
@@ -174,11 +176,42 @@ pub fn add_gltf(
             ));
         }
     }
+    // gltf-json's validation indexes the accessors by a primitive's POSITION unchecked (it
+    // panics on an out-of-range index): check those first.
+    let json = raw.document.as_json();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let position = gltf::json::validation::Checked::Valid(gltf::Semantic::Positions);
+            if let Some(a) = prim.attributes.get(&position)
+                && a.value() >= json.accessors.len()
+            {
+                return Err(gltf_err(
+                    path,
+                    format!(
+                        "mesh {m} primitive {p}: POSITION accessor {} does not exist",
+                        a.value()
+                    ),
+                ));
+            }
+        }
+    }
+    // External files are read whole by the gltf crate: each must be a regular file (not
+    // /dev/zero, a pipe or a directory), and its URI must decode (the crate panics otherwise).
+    let base = path.parent().unwrap_or_else(|| Path::new("."));
+    let uris = (json.buffers.iter().filter_map(|b| b.uri.as_deref()))
+        .chain(json.images.iter().filter_map(|i| i.uri.as_deref()));
+    for uri in uris {
+        // (a missing file is left to the gltf crate, whose message names the buffer)
+        if let Some(file) = external_file(base, uri).map_err(|e| gltf_err(path, e))?
+            && file.exists()
+        {
+            regular_file(&file).map_err(|e| gltf_err(path, e))?;
+        }
+    }
     drop(raw);
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice(&bytes).map_err(|e| gltf_err(path, e.to_string()))?;
     drop(bytes);
-    let base = path.parent().unwrap_or_else(|| Path::new("."));
     let buffers = gltf::import_buffers(&document, Some(base), blob)
         .map_err(|e| gltf_err(path, format!("buffers: {e}")))?;
     let mut loader = Loader {
@@ -203,6 +236,45 @@ pub fn add_gltf(
             "the file could not be read (malformed data)",
         )),
     }
+}
+
+/// An error unless `path` is a regular file (reading a device or a pipe whole never ends).
+pub(crate) fn regular_file(path: &Path) -> Result<(), String> {
+    let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if meta.is_file() {
+        Ok(())
+    } else {
+        Err(format!("{} is not a regular file", path.display()))
+    }
+}
+
+/// The file an external glTF URI names (None for data URIs and unsupported schemes, which the
+/// gltf crate refuses itself); relative URIs are percent-decoded and must be UTF-8.
+fn external_file(base: &Path, uri: &str) -> Result<Option<std::path::PathBuf>, String> {
+    if uri.contains(':') {
+        let file = uri
+            .strip_prefix("file://")
+            .or_else(|| uri.strip_prefix("file:"));
+        return Ok(file.map(std::path::PathBuf::from));
+    }
+    let mut bytes = Vec::with_capacity(uri.len());
+    let mut rest = uri.as_bytes();
+    while let Some((&c, tail)) = rest.split_first() {
+        let hex = |b: u8| (b as char).to_digit(16);
+        match (c, tail) {
+            (b'%', [h, l, more @ ..]) if hex(*h).is_some() && hex(*l).is_some() => {
+                bytes.push((hex(*h).unwrap_or(0) * 16 + hex(*l).unwrap_or(0)) as u8);
+                rest = more;
+            }
+            _ => {
+                bytes.push(c);
+                rest = tail;
+            }
+        }
+    }
+    let decoded =
+        String::from_utf8(bytes).map_err(|_| format!("URI `{uri}` does not decode to UTF-8"))?;
+    Ok(Some(base.join(decoded)))
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -321,6 +393,8 @@ impl Loader<'_> {
             if prim.get(&gltf::Semantic::Colors(0)).is_some() {
                 self.report.warn("vertex colours (COLOR_0) ignored".into());
             }
+            check_accessor_types(&prim)
+                .map_err(|e| self.err(format!("mesh `{mesh_name}`: {e}")))?;
             let buffers = self.buffers;
             let reader = prim.reader(|b| buffers.get(b.index()).map(|d| &d.0[..]));
             let positions: Vec<Vec3> = match reader.read_positions() {
@@ -503,6 +577,8 @@ impl Loader<'_> {
         if let Some(t) = self.textures.get(&key) {
             return Ok(t.clone());
         }
+        self.check_image_source(image.index())
+            .map_err(|e| self.err(format!("image {}: {e}", image.index())))?;
         let data = gltf::image::Data::from_source(image.source(), Some(self.base), self.buffers)
             .map_err(|e| self.err(format!("image {}: {e}", image.index())))?;
         let t = Arc::new(
@@ -511,6 +587,36 @@ impl Loader<'_> {
         );
         self.textures.insert(key, t.clone());
         Ok(t)
+    }
+
+    /// What the gltf crate's image reading assumes unchecked (it panics otherwise): a buffer
+    /// view image has a MIME type and lies inside its buffer; any other has a URI.
+    fn check_image_source(&self, index: usize) -> Result<(), String> {
+        let json = self.doc.as_json();
+        let img = json.images.get(index).ok_or("does not exist")?;
+        match &img.buffer_view {
+            Some(v) => {
+                if img.mime_type.is_none() {
+                    return Err("a buffer view image needs a mimeType".into());
+                }
+                let view = json
+                    .buffer_views
+                    .get(v.value())
+                    .ok_or("its buffer view does not exist")?;
+                let data = self
+                    .buffers
+                    .get(view.buffer.value())
+                    .ok_or("its buffer does not exist")?;
+                let end = (view.byte_offset.map_or(0, |o| o.0) as usize)
+                    .checked_add(view.byte_length.0 as usize);
+                if end.is_none_or(|e| e > data.0.len()) {
+                    return Err("its buffer view runs past its buffer".into());
+                }
+                Ok(())
+            }
+            None if img.uri.is_none() => Err("has neither a uri nor a bufferView".into()),
+            None => Ok(()),
+        }
     }
 
     fn add_light(
@@ -665,6 +771,53 @@ fn triangle_list(mode: gltf::mesh::Mode, idx: &[u32]) -> Vec<u32> {
             .collect(),
         _ => idx[..idx.len() / 3 * 3].to_vec(),
     }
+}
+
+/// The component types and shapes the gltf crate's readers assume of the accessors read here
+/// (it panics on others): float VEC3 positions and normals, float or normalised-integer VEC2
+/// uvs, unsigned-integer scalar indices.
+fn check_accessor_types(prim: &gltf::Primitive) -> Result<(), String> {
+    use gltf::Semantic;
+    use gltf::accessor::{DataType, Dimensions};
+    let check = |what: &str, a: gltf::Accessor, types: &[DataType], dims: Dimensions| {
+        let element = a.data_type().size() * a.dimensions().multiplicity();
+        let stride = a.view().and_then(|v| v.stride()).unwrap_or(element);
+        if stride < element {
+            return Err(format!(
+                "{what} accessor {}: byteStride {stride} is less than its {element}-byte elements",
+                a.index()
+            ));
+        }
+        if types.contains(&a.data_type()) && a.dimensions() == dims {
+            Ok(())
+        } else {
+            Err(format!(
+                "{what} accessor {} is {:?} {:?}, not {:?} of {types:?}",
+                a.index(),
+                a.data_type(),
+                a.dimensions(),
+                dims
+            ))
+        }
+    };
+    for (semantic, a) in prim.attributes() {
+        match semantic {
+            Semantic::Positions => check("POSITION", a, &[DataType::F32], Dimensions::Vec3)?,
+            Semantic::Normals => check("NORMAL", a, &[DataType::F32], Dimensions::Vec3)?,
+            Semantic::TexCoords(_) => check(
+                "TEXCOORD",
+                a,
+                &[DataType::F32, DataType::U8, DataType::U16],
+                Dimensions::Vec2,
+            )?,
+            _ => {}
+        }
+    }
+    if let Some(a) = prim.indices() {
+        let unsigned = [DataType::U8, DataType::U16, DataType::U32];
+        check("index", a, &unsigned, Dimensions::Scalar)?;
+    }
+    Ok(())
 }
 
 /// A decoded glTF image as a linear RGBA texture (grey images replicate to RGB).

@@ -191,6 +191,44 @@ pub struct SceneBuilder {
     stats: SceneStats,
 }
 
+/// The largest coordinate (and sphere radius) a scene may have: squares and areas of larger
+/// ones overflow f32, and the BVH builder fails on them.
+pub const MAX_COORDINATE: f32 = 1e18;
+
+fn within_range(p: Vec3) -> bool {
+    p.is_finite() && p.abs().max_element() <= MAX_COORDINATE
+}
+
+/// A material's factors must be finite and non-negative (NaN there makes NaN pixels).
+fn check_material(m: &Material) -> Result<(), SceneError> {
+    let model_ok = match m.model {
+        crate::material::Model::PbrtPlastic { ks, alpha } => {
+            ks.is_finite() && ks.min_element() >= 0.0 && alpha.is_finite() && alpha >= 0.0
+        }
+        _ => true,
+    };
+    let ok = m.base_color.is_finite()
+        && m.base_color.min_element() >= 0.0
+        && [m.metallic, m.roughness, m.specular]
+            .iter()
+            .all(|x| x.is_finite() && *x >= 0.0)
+        && model_ok;
+    if ok {
+        Ok(())
+    } else {
+        Err(SceneError::BadMaterial {
+            name: m.name.clone(),
+            message: format!(
+                "base colour {:?}, metallic {}, roughness {}, specular {} must be finite and non-negative",
+                m.base_color.to_array(),
+                m.metallic,
+                m.roughness,
+                m.specular
+            ),
+        })
+    }
+}
+
 fn check_emission(what: &str, e: Vec3) -> Result<(), SceneError> {
     if !e.is_finite() || e.min_element() < 0.0 {
         return Err(SceneError::BadEmission {
@@ -270,6 +308,11 @@ impl SceneBuilder {
             .iter()
             .map(|p| transform.transform_point3(*p))
             .collect();
+        if !wp.iter().all(|p| within_range(*p)) {
+            return Err(SceneError::NonFiniteVertex {
+                mesh: mesh_name.into(),
+            });
+        }
         let wn: Option<Vec<Vec3>> = normals.map(|ns| {
             ns.iter()
                 .map(|n| normal_matrix.transform_vector3(*n).normalize_or_zero())
@@ -355,7 +398,7 @@ impl SceneBuilder {
         spot: Option<SpotCone>,
     ) -> Result<(), SceneError> {
         check_emission("sphere light", radiance)?;
-        if !center.is_finite() || !(radius > 0.0) || !radius.is_finite() {
+        if !within_range(center) || !(radius > 0.0) || !(radius <= MAX_COORDINATE) {
             return Err(SceneError::BadLight {
                 what: "sphere".into(),
                 message: format!("center {center:?}, radius {radius}"),
@@ -381,7 +424,7 @@ impl SceneBuilder {
         spot: Option<SpotCone>,
     ) -> Result<(), SceneError> {
         check_emission("point light", intensity)?;
-        if !position.is_finite() {
+        if !within_range(position) {
             return Err(SceneError::BadLight {
                 what: "point".into(),
                 message: format!("position {position:?}"),
@@ -469,6 +512,10 @@ impl SceneBuilder {
     pub fn build(mut self) -> Result<Scene, SceneError> {
         if self.triangles.is_empty() && self.lights.is_empty() {
             return Err(SceneError::Empty);
+        }
+        // Checked here, not in add_material: compositions override factors after adding.
+        for m in &self.materials {
+            check_material(m)?;
         }
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);

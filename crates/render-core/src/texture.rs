@@ -35,7 +35,11 @@ impl Texture {
         let x0 = x.floor();
         let y0 = y.floor();
         let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
+        // Wrapped first (texel() wraps again) so that x0 + 1 cannot overflow at huge uvs.
+        let (x0, y0) = (
+            (x0 as i64).rem_euclid(self.width as i64),
+            (y0 as i64).rem_euclid(self.height as i64),
+        );
         let a = self.texel(x0, y0).lerp(self.texel(x0 + 1, y0), fx);
         let b = self.texel(x0, y0 + 1).lerp(self.texel(x0 + 1, y0 + 1), fx);
         a.lerp(b, fy)
