@@ -7,7 +7,14 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use light_tree::{LightBounds, LightTree};
+use light_tree::{LightBounds, LightTree, SplitCriterion, SplitParams};
+
+/// The authors' cut: τ = 0.85, their σ, at most 64 nodes (the figures in the README).
+const SPLIT: SplitParams = SplitParams {
+    tau: 0.85,
+    max_size: 64,
+    criterion: SplitCriterion::Authors,
+};
 use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use std::f32::consts::{FRAC_PI_2, PI};
@@ -123,7 +130,7 @@ fn bench_queries(c: &mut Criterion) {
             b.iter(|| {
                 let mut acc = 0usize;
                 for &(x, nrm, _) in &qs {
-                    acc += tree.adaptive_cut(x, nrm, 0.85, 64).len();
+                    acc += tree.adaptive_cut(x, nrm, &SPLIT).len();
                 }
                 acc
             })

@@ -190,8 +190,19 @@ fn make_node(agg: &Agg, depth: u32, child_or_light: u32, leaf: bool) -> (Node, N
             theta_o: cone.theta_o,
             theta_e: cone.theta_e,
             power_sq_sum: agg.power_sq as f32,
+            power_cv2: power_cv2(agg.count, agg.power, agg.power_sq) as f32,
         },
     )
+}
+
+/// V[Φ]/E[Φ]² of `n` lights of total power `sum` and Σ Φ² `sum_sq`, with the sample variance
+/// (n − 1): n·(n·ΣΦ²/Φ² − 1)/(n − 1); 0 for one light or zero total power.
+fn power_cv2(n: u32, sum: f64, sum_sq: f64) -> f64 {
+    if n <= 1 || !(sum > 0.0) {
+        return 0.0;
+    }
+    let n = n as f64;
+    (n * (n * sum_sq / (sum * sum) - 1.0) / (n - 1.0)).max(0.0)
 }
 
 #[inline]

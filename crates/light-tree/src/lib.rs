@@ -11,7 +11,8 @@
 //! * [`LightTree::sample`] / [`LightTree::pmf`]: single stochastic descent and its exact
 //!   replay; [`LightTree::sample_subtree`] / [`LightTree::pmf_subtree`] do the same from any
 //!   node with any node importance.
-//! * [`LightTree::cut`] / [`LightTree::adaptive_cut`]: cuts for adaptive tree splitting.
+//! * [`LightTree::cut`] / [`LightTree::adaptive_cut`]: cuts for adaptive tree splitting, with
+//!   the authors' E&K criterion in scene units or our unit-free one ([`SplitCriterion`]).
 //!
 //! A descent that reaches a node whose two children both have zero importance returns `None`
 //! (with conservative bounds, every light below is dark at `x`), so Σ pmf over all lights is
@@ -23,10 +24,12 @@ mod build;
 mod cone;
 mod query;
 #[cfg(test)]
+mod split_tests;
+#[cfg(test)]
 mod tests;
 
 pub use cone::Cone;
-pub use query::{Cut, DescentRandom, Fresh, Rescaled};
+pub use query::{Cut, DescentRandom, Fresh, Rescaled, SplitCriterion, SplitParams};
 
 use glam::Vec3;
 use std::fmt;
@@ -161,6 +164,9 @@ pub struct NodeExtra {
     pub theta_e: f32,
     /// Σ Φᵢ² over the subtree's lights (for the E&K variance metric).
     pub power_sq_sum: f32,
+    /// V[Φ]/E[Φ]² over the subtree's lights (sample variance, N − 1): the squared coefficient
+    /// of variation of the lights' powers, unit-free; 0 for one light or zero power.
+    pub power_cv2: f32,
 }
 
 impl Node {

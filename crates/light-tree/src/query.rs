@@ -201,29 +201,95 @@ impl LightTree {
         }
     }
 
-    /// E&K's normalised variance measure ρ ∈ (0, 1] (eqs. 8–10 with the normalisation,
-    /// σ² multiplied by N² as in bisml and the GSoC Cycles tree): low ρ = high variance.
-    /// Leaves return 1. Distances are in scene units, so τ is scale-dependent as in E&K.
-    pub fn split_metric(&self, node: NodeId, x: Vec3) -> f32 {
+    /// E&K's normalised variance measure ρ = (1/(1 + σ))^{1/4} ∈ (0, 1] of `node` seen from
+    /// `x` under `criterion` (σ from [`LightTree::split_sigma`]): low ρ = high variance.
+    /// Leaves return 1.
+    pub fn split_metric(&self, node: NodeId, x: Vec3, criterion: SplitCriterion) -> f32 {
+        (1.0 / (1.0 + self.split_sigma(node, x, criterion))).powf(0.25) as f32
+    }
+
+    /// The σ behind E&K's splitting (their eqs. 8–10), for a node of N lights whose bounding
+    /// sphere (c, r) lies at distance d from `x`: distances uniform in [a, b] = [d − r, d + r]
+    /// give the geometric term g = 1/dist² the mean E[g] = 1/(ab) and the variance
+    /// V[g] = (b³ − a³)/(3(b − a)a³b³) − 1/(a²b²); the lights' powers give E[e] = Φ/N and V[e].
+    ///
+    /// * [`SplitCriterion::Authors`]: σ = N·√(V[e]V[g] + V[e]E[g]² + E[e]²V[g]) in scene
+    ///   units (power / length²), with the authors' V[e] = ⌊1/(N − 1)⌋·(ΣΦ² − N·E[e]²): their
+    ///   integer division makes it 0 for N ≥ 3; a = max(d − r, 1e-9).
+    /// * [`SplitCriterion::UnitFree`]: the same σ over the node's expected contribution
+    ///   N·E[e]·E[g], i.e. the coefficient of variation of a one-light estimate of the node,
+    ///   √((1 + V[e]/E[e]²)(1 + V[g]/E[g]²) − 1) with V[g]/E[g]² = 4r²/(3(d² − r²)): scaling
+    ///   every power or every length leaves it unchanged. Infinite inside the sphere.
+    ///
+    /// Leaves return 0.
+    pub fn split_sigma(&self, node: NodeId, x: Vec3, criterion: SplitCriterion) -> f64 {
         let nd = &self.nodes[node as usize];
         let n = nd.num_lights;
         if n <= 1 {
-            return 1.0;
+            return 0.0;
         }
-        let nf = n as f64;
-        let d = ((nd.center() - x).length()) as f64;
-        let r = nd.radius as f64;
-        let a = (d - r).max(1e-9);
-        let b = d + r;
-        let e_g = 1.0 / (a * b);
-        // (b³ − a³)/(3(b − a)a³b³) − 1/(a²b²), with (b³ − a³)/(b − a) = a² + ab + b².
-        let ab = a * b;
-        let v_g = ((a * a + ab + b * b) / (3.0 * ab * ab * ab) - 1.0 / (ab * ab)).max(0.0);
-        let e_e = nd.power as f64 / nf;
-        let v_e = ((self.extra[node as usize].power_sq_sum as f64 - nf * e_e * e_e) / (nf - 1.0))
-            .max(0.0);
-        let s2 = (v_e * v_g + v_e * e_g * e_g + e_e * e_e * v_g) * nf * nf;
-        (1.0 / (1.0 + s2.sqrt())).powf(0.25) as f32
+        let ex = &self.extra[node as usize];
+        match criterion {
+            SplitCriterion::UnitFree => {
+                let d2 = (nd.center() - x).length_squared() as f64;
+                let r2 = (nd.radius * nd.radius) as f64;
+                if d2 <= r2 {
+                    return f64::INFINITY;
+                }
+                let cg = 4.0 * r2 / (3.0 * (d2 - r2));
+                ((1.0 + ex.power_cv2 as f64) * (1.0 + cg) - 1.0)
+                    .max(0.0)
+                    .sqrt()
+            }
+            SplitCriterion::Authors => {
+                let nf = n as f64;
+                let d = ((nd.center() - x).length()) as f64;
+                let r = nd.radius as f64;
+                let a = (d - r).max(1e-9);
+                let b = d + r;
+                let e_g = 1.0 / (a * b);
+                // (b³ − a³)/(b − a) = a² + ab + b².
+                let ab = a * b;
+                let v_g = ((a * a + ab + b * b) / (3.0 * ab * ab * ab) - 1.0 / (ab * ab)).max(0.0);
+                let e_e = nd.power as f64 / nf;
+                // 1 / (N − 1) in integers: 1 for two lights, 0 from three on.
+                let v_e = if n == 2 {
+                    (ex.power_sq_sum as f64 - nf * e_e * e_e).max(0.0)
+                } else {
+                    0.0
+                };
+                (v_e * v_g + v_e * e_g * e_g + e_e * e_e * v_g).sqrt() * nf
+            }
+        }
+    }
+
+    /// `true` when E&K's ρ < τ, i.e. σ > τ⁻⁴ − 1 (`sigma_min`), without powf or, for the
+    /// unit-free criterion, any square root: compared as squares.
+    #[inline]
+    fn split_by_variance(
+        &self,
+        node: NodeId,
+        x: Vec3,
+        criterion: SplitCriterion,
+        sigma_min: f32,
+    ) -> bool {
+        let nd = &self.nodes[node as usize];
+        if nd.num_lights <= 1 {
+            return false;
+        }
+        match criterion {
+            SplitCriterion::UnitFree => {
+                let d2 = (nd.center() - x).length_squared();
+                let r2 = nd.radius * nd.radius;
+                if d2 <= r2 {
+                    return true;
+                }
+                let cg = 4.0 * r2 / (3.0 * (d2 - r2));
+                let cv2 = (1.0 + self.extra[node as usize].power_cv2) * (1.0 + cg) - 1.0;
+                cv2 > sigma_min * sigma_min
+            }
+            SplitCriterion::Authors => self.split_sigma(node, x, criterion) > sigma_min as f64,
+        }
     }
 
     /// Conty Estevez & Kulla importance Φ · cos θ′ · cos θ′ᵢ / d² of node `node` for a receiver
@@ -360,9 +426,23 @@ impl LightTree {
     /// node is replaced by its two children when `should_split(node)` holds and the cut has
     /// fewer than `max_size` nodes. Leaves are never split. The result is sorted by DFS id
     /// and has at most `max(max_size, 1)` nodes.
-    pub fn cut<S: FnMut(NodeId) -> bool>(&self, max_size: usize, mut should_split: S) -> Cut {
+    pub fn cut<S: FnMut(NodeId) -> bool>(&self, max_size: usize, should_split: S) -> Cut {
         let mut out = Cut::default();
-        let mut queue = VecDeque::new();
+        self.cut_into(&mut out, &mut VecDeque::new(), max_size, should_split);
+        out
+    }
+
+    /// [`LightTree::cut`] reusing the caller's buffers (`queue` is scratch), so that a cut per
+    /// shading point allocates nothing.
+    pub fn cut_into<S: FnMut(NodeId) -> bool>(
+        &self,
+        out: &mut Cut,
+        queue: &mut VecDeque<NodeId>,
+        max_size: usize,
+        mut should_split: S,
+    ) {
+        out.nodes.clear();
+        queue.clear();
         queue.push_back(self.root());
         let mut size = 1usize;
         while let Some(id) = queue.pop_front() {
@@ -376,17 +456,66 @@ impl LightTree {
             }
         }
         out.nodes.sort_unstable();
-        out
     }
 
     /// E&K adaptive cut for a receiver at (`x`, `n`): split a node when `x` lies inside its
-    /// bounding sphere or its [`LightTree::split_metric`] is below `tau` (0.85 in the authors'
-    /// code), at most `max_size` nodes. Nodes of zero importance are never split (all their
-    /// lights are provably dark at `x`).
-    pub fn adaptive_cut(&self, x: Vec3, n: Vec3, tau: f32, max_size: usize) -> Cut {
-        self.cut(max_size, |id| {
+    /// bounding sphere or its [`LightTree::split_metric`] is below `params.tau`, at most
+    /// `params.max_size` nodes. With the unit-free criterion nodes of zero importance are never
+    /// split (all their lights are provably dark at `x`); the authors' cut splits them too.
+    pub fn adaptive_cut(&self, x: Vec3, n: Vec3, params: &SplitParams) -> Cut {
+        let mut out = Cut::default();
+        self.adaptive_cut_into(&mut out, &mut VecDeque::new(), x, n, params);
+        out
+    }
+
+    /// [`LightTree::adaptive_cut`] reusing the caller's buffers (`queue` is scratch).
+    pub fn adaptive_cut_into(
+        &self,
+        out: &mut Cut,
+        queue: &mut VecDeque<NodeId>,
+        x: Vec3,
+        n: Vec3,
+        params: &SplitParams,
+    ) {
+        let sigma_min = params.sigma_min();
+        let criterion = params.criterion;
+        self.cut_into(out, queue, params.max_size, |id| {
             let node = &self.nodes[id as usize];
-            (node.contains(x) || self.split_metric(id, x) < tau) && node.importance(x, n) > 0.0
+            let split = node.contains(x) || self.split_by_variance(id, x, criterion, sigma_min);
+            match criterion {
+                SplitCriterion::Authors => split,
+                SplitCriterion::UnitFree => split && node.importance(x, n) > 0.0,
+            }
         })
+    }
+}
+
+/// Which σ E&K splitting compares with τ (see [`LightTree::split_sigma`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SplitCriterion {
+    /// The coefficient of variation of the node's one-light estimate: no units, so a scene's
+    /// scale or brightness changes no cut (our default).
+    #[default]
+    UnitFree,
+    /// bisml's σ in scene units with its zeroed V[e] (`--reproduce`).
+    Authors,
+}
+
+/// Parameters of an adaptive cut.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SplitParams {
+    /// Split when ρ = (1/(1 + σ))^{1/4} < τ (τ ∈ [0, 1]; the authors use 0.85).
+    pub tau: f32,
+    /// Most nodes in the cut (`usize::MAX`: no cap, as in the authors' code).
+    pub max_size: usize,
+    pub criterion: SplitCriterion,
+}
+
+impl SplitParams {
+    /// σ above which ρ < τ: τ⁻⁴ − 1 (infinite for τ = 0: never split by variance).
+    #[inline]
+    pub fn sigma_min(&self) -> f32 {
+        let t2 = self.tau * self.tau;
+        1.0 / (t2 * t2) - 1.0
     }
 }

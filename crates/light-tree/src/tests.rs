@@ -5,7 +5,10 @@ use chi2_test::{chi2_test, sidak_significance as sidak};
 fn counts(observed: &[u64]) -> Vec<f64> {
     observed.iter().map(|&o| o as f64).collect()
 }
-use crate::{BuildError, Fresh, LightBounds, LightTree, MAX_DEPTH, NodeId, Rescaled};
+use crate::{
+    BuildError, Fresh, LightBounds, LightTree, MAX_DEPTH, NodeId, Rescaled, SplitCriterion,
+    SplitParams,
+};
 use glam::Vec3;
 use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg32;
@@ -498,9 +501,23 @@ fn adaptive_cut_partitions_lights() {
         let tree = LightTree::build(&lights).unwrap();
         for _ in 0..5 {
             let (x, nrm) = rand_receiver(&mut rng);
-            for tau in [0.5, 0.85, 0.99] {
+            for (tau, criterion) in [
+                (0.5, SplitCriterion::Authors),
+                (0.85, SplitCriterion::Authors),
+                (0.99, SplitCriterion::Authors),
+                (0.85, SplitCriterion::UnitFree),
+                (0.99, SplitCriterion::UnitFree),
+            ] {
                 for max_size in [0usize, 1, 4, 32, usize::MAX] {
-                    let cut = tree.adaptive_cut(x, nrm, tau, max_size);
+                    let cut = tree.adaptive_cut(
+                        x,
+                        nrm,
+                        &SplitParams {
+                            tau,
+                            max_size,
+                            criterion,
+                        },
+                    );
                     check_partition(&tree, &cut, max_size);
                     if max_size == usize::MAX {
                         sizes.push(cut.len());
@@ -552,7 +569,15 @@ fn generic_cut_respects_predicate_and_budget() {
         .map(|_| LightBounds::point(rand_in_box(&mut rng, 1.0), 1.0))
         .collect();
     let st = LightTree::build(&spheres).unwrap();
-    let c = st.adaptive_cut(Vec3::splat(3.0), Vec3::ZERO, 1.1, usize::MAX);
+    let c = st.adaptive_cut(
+        Vec3::splat(3.0),
+        Vec3::ZERO,
+        &SplitParams {
+            tau: 1.0,
+            max_size: usize::MAX,
+            criterion: SplitCriterion::Authors,
+        },
+    );
     assert_eq!(c.len(), 50);
 }
 

@@ -313,6 +313,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "rays": { "camera": result.counters.camera_rays, "shadow": result.counters.shadow_rays, "bsdf": result.counters.bsdf_rays },
         "shading_points": result.counters.shading_points,
         "technique_samples": technique_samples,
+        "light_selection": result.counters.selection_means(),
         "unlit_pixel_fraction": result.light_fraction.iter().filter(|&&f| f == 0.0).count() as f64 / result.light_fraction.len() as f64,
         "aux_files": aux_files,
         "version": env!("CARGO_PKG_VERSION"),
@@ -333,6 +334,31 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             result.passes,
             closest as f64 / secs / 1e6,
             result.counters.shadow_rays as f64 / secs / 1e6
+        );
+    }
+    if args.stats {
+        let c = &result.counters;
+        let per = |v: u64, n: u64| if n > 0 { v as f64 / n as f64 } else { 0.0 };
+        let (n, g) = (c.shading_points, c.glossy_points);
+        eprintln!(
+            "CPU {:.2} s ({:.3} s per spp); {} shading points, {} glossy ({:.1} %)",
+            result.cpu_seconds.unwrap_or(f64::NAN),
+            result.cpu_seconds.unwrap_or(f64::NAN) / result.spp.max(1) as f64,
+            n,
+            g,
+            100.0 * per(g, n)
+        );
+        eprintln!(
+            "per shading point: LS clusters {:.2}, BO clusters {:.2}, BRDF-aware samples {:.2}",
+            per(c.ls_clusters, n),
+            per(c.bo_clusters, n),
+            per(c.brdf_aware_samples, n)
+        );
+        eprintln!(
+            "per glossy point:  LS clusters {:.2}, BO clusters {:.2}, BRDF-aware samples {:.2}",
+            per(c.ls_clusters_glossy, g),
+            per(c.bo_clusters, g),
+            per(c.brdf_aware_samples_glossy, g)
         );
     }
     Ok(())

@@ -173,6 +173,18 @@ impl Light {
         }
     }
 
+    /// Power in the authors' units (bisml `LeWithArea`, for `--reproduce`): luminance of the
+    /// radiance × area for area lights (no π, one side even when two-sided; a sphere's area is
+    /// 4πr²), the intensity's luminance for point and spot lights. Not comparable across kinds.
+    pub fn power_authors(&self) -> f32 {
+        let l = luminance(self.mean_emission).max(0.0);
+        match &self.shape {
+            LightShape::Triangle { area, .. } => l * area,
+            LightShape::Sphere { radius, .. } => l * 4.0 * PI * radius * radius,
+            LightShape::Point { .. } => l,
+        }
+    }
+
     /// Axis-aligned bounds.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         match &self.shape {

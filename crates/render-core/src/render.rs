@@ -261,6 +261,7 @@ fn shade_camera_sample(
         bsdf: Bsdf::new(hit.ns, hit.ng, wo, params),
     };
     ctx.counters.shading_points += 1;
+    ctx.counters.glossy_points += !sp.bsdf.is_pure_diffuse() as u64;
     l += strategy.estimate(scene, &sp, rng, ctx);
     l += distant_lighting(scene, &sp, ctx);
     (l, sees_light)

@@ -12,18 +12,21 @@ pub mod brdf_oriented;
 pub mod bsdf_sampling;
 pub mod convergence;
 pub mod light_strategy;
+pub mod memo;
 pub mod mis;
 pub mod oracle;
 pub mod ris;
+pub mod scratch;
 pub mod selection;
 pub mod tree_selection;
 
 use light_strategy::{BsdfStrategy, LightStrategy};
+use light_tree::{SplitCriterion, SplitParams};
 use render_core::estimator::DirectLighting;
 use render_core::scene::Scene;
 use selection::{PowerSelection, UniformSelection};
 use serde::{Deserialize, Serialize};
-use tree_selection::{TreeMode, TreeSelection};
+use tree_selection::{PowerUnits, TreeMode, TreeSelection};
 
 /// Knobs of the strategies, each with its default; strategies ignore the ones they do not use.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -41,8 +44,10 @@ pub struct StrategyOptions {
     pub lambda: f32,
     /// Cap-integral approximation behind BO.
     pub brdf_integral: brdf_oriented::BrdfIntegral,
-    /// Every behaviour of the authors' code (nearest SPTD lookup, Oat–Sander cap ∩ cap,
-    /// glossy-only importance, one rescaled random number, in-sample allocation).
+    /// Every behaviour of the authors' code, for every tree strategy: their power units
+    /// (`LeWithArea`), their E&K σ (scene units, V[e] = 0 from three lights on), no cap on
+    /// either cut; for the method also the nearest SPTD lookup, Oat–Sander cap ∩ cap,
+    /// glossy-only importance, their random-number use and the in-sample allocation.
     pub reproduce: bool,
     /// Sample points on sphere lights by the pivot-transformed lobe (mixed with cone sampling).
     pub pivot_sphere: bool,
@@ -50,6 +55,35 @@ pub struct StrategyOptions {
     pub adaptive_total: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
+}
+
+impl StrategyOptions {
+    /// The E&K cut's parameters: the authors' σ in scene units and no cap under `reproduce`,
+    /// our unit-free σ and `max_cut` otherwise.
+    pub fn split_params(&self) -> SplitParams {
+        if self.reproduce {
+            SplitParams {
+                tau: self.tau,
+                max_size: usize::MAX,
+                criterion: SplitCriterion::Authors,
+            }
+        } else {
+            SplitParams {
+                tau: self.tau,
+                max_size: self.max_cut,
+                criterion: SplitCriterion::UnitFree,
+            }
+        }
+    }
+
+    /// The light tree's power units: the authors' `LeWithArea` under `reproduce`.
+    pub fn power_units(&self) -> PowerUnits {
+        if self.reproduce {
+            PowerUnits::Authors
+        } else {
+            PowerUnits::Watts
+        }
+    }
 }
 
 impl Default for StrategyOptions {
@@ -159,26 +193,28 @@ pub fn create(
             opts.max_cut, opts.tau
         )));
     }
-    let tree =
-        |mode: TreeMode, with_bsdf: bool| -> Result<Box<dyn DirectLighting>, StrategyError> {
-            let parameters = match mode {
-                TreeMode::Single => serde_json::Value::Null,
-                TreeMode::Split { tau, max_cut } => {
-                    serde_json::json!({ "tau": tau, "max_cut": max_cut })
-                }
-            };
-            let selection = TreeSelection::new(scene, mode).map_err(StrategyError::BadOption)?;
-            Ok(Box::new(LightStrategy {
-                name: name.into(),
-                selection,
-                with_bsdf,
-                parameters,
-            }))
+    let units = opts.power_units();
+    let tree = |mode: TreeMode,
+                with_bsdf: bool|
+     -> Result<Box<dyn DirectLighting>, StrategyError> {
+        let parameters = match mode {
+            TreeMode::Single => serde_json::json!({ "reproduce": opts.reproduce }),
+            TreeMode::Split(p) => serde_json::json!({
+                "tau": p.tau,
+                "max_cut": opts.max_cut,
+                "split_criterion": format!("{:?}", p.criterion).to_lowercase(),
+                "reproduce": opts.reproduce,
+            }),
         };
-    let split = TreeMode::Split {
-        tau: opts.tau,
-        max_cut: opts.max_cut,
+        let selection = TreeSelection::new(scene, mode, units).map_err(StrategyError::BadOption)?;
+        Ok(Box::new(LightStrategy {
+            name: name.into(),
+            selection,
+            with_bsdf,
+            parameters,
+        }))
     };
+    let split = TreeMode::Split(opts.split_params());
     Ok(match name {
         "tree" => tree(TreeMode::Single, false)?,
         "tree+bsdf" => tree(TreeMode::Single, true)?,
@@ -243,10 +279,8 @@ fn mis3(
     };
     let ls = TreeSelection::new(
         scene,
-        TreeMode::Split {
-            tau: opts.tau,
-            max_cut: opts.max_cut,
-        },
+        TreeMode::Split(opts.split_params()),
+        opts.power_units(),
     )
     .map_err(StrategyError::BadOption)?;
     let config = BoConfig {
@@ -254,8 +288,8 @@ fn mis3(
         n_max: opts.n_max,
         lambda: opts.lambda,
         tau: opts.tau,
-        max_cut: opts.max_cut,
-        max_cut_bo: opts.max_cut,
+        max_cut: opts.split_params().max_size,
+        max_cut_bo: opts.split_params().max_size,
         brdf_integral: opts.brdf_integral,
         reproduce: opts.reproduce,
         pivot_sphere: opts.pivot_sphere,
@@ -325,7 +359,7 @@ fn ris(
     opts: &StrategyOptions,
 ) -> Result<Box<dyn DirectLighting>, StrategyError> {
     use brdf_oriented::BrdfIntegral;
-    let tree = TreeSelection::new(scene, TreeMode::Single)
+    let tree = TreeSelection::new(scene, TreeMode::Single, opts.power_units())
         .map_err(StrategyError::BadOption)?
         .tree;
     Ok(match opts.brdf_integral {

@@ -2,6 +2,7 @@
 //! MIS (power heuristic, one sample of each; a splitting selection counts as one sample).
 use crate::bsdf_sampling::sample_bsdf;
 use crate::mis::power2;
+use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use render_core::Vec3;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
@@ -9,7 +10,6 @@ use render_core::light::LightSample;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
-use std::cell::RefCell;
 
 pub struct LightStrategy<S: LightSelection> {
     pub name: String,
@@ -18,11 +18,10 @@ pub struct LightStrategy<S: LightSelection> {
     pub parameters: serde_json::Value,
 }
 
-thread_local! {
-    /// The picks of one shading point, reused by every sample the thread draws: no heap
-    /// allocation per sample.
-    static PICKS: RefCell<Vec<(u32, f32)>> = const { RefCell::new(Vec::new()) };
-}
+/// Per-thread buffer of the lights a selection picked at one shading point.
+#[derive(Default)]
+pub struct Picks(pub Vec<(u32, f32)>);
+crate::scratch_pool!(Picks, |p| p.0.clear());
 
 pub const TECHNIQUE_LIGHT: usize = 0;
 pub const TECHNIQUE_BSDF: usize = 1;
@@ -72,25 +71,29 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let state = self.selection.prepare(scene, sp);
+        let mut picks = Pooled::<Picks>::take();
+        self.selection.pick(&state, sp, rng, &mut picks.0);
+        ctx.counters.record_selection(
+            !sp.bsdf.is_pure_diffuse(),
+            self.selection.clusters(&state),
+            0,
+            self.with_bsdf as usize,
+        );
         let x = sp.point();
         let mut l = Vec3::ZERO;
-        PICKS.with_borrow_mut(|picks| {
-            picks.clear();
-            self.selection.pick(&state, sp, rng, picks);
-            for &(light, pmf) in picks.iter() {
-                ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
-                let Some((s, p_light, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters)
-                else {
-                    continue;
-                };
-                let w = if self.with_bsdf && !s.is_delta {
-                    power2(p_light, sp.bsdf.pdf(sp.wo, s.wi))
-                } else {
-                    1.0
-                };
-                l += f * (w / p_light);
-            }
-        });
+        for &(light, pmf) in &picks.0 {
+            ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
+            let Some((s, p_light, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters)
+            else {
+                continue;
+            };
+            let w = if self.with_bsdf && !s.is_delta {
+                power2(p_light, sp.bsdf.pdf(sp.wo, s.wi))
+            } else {
+                1.0
+            };
+            l += f * (w / p_light);
+        }
         if self.with_bsdf {
             ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
             if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)

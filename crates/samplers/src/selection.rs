@@ -11,6 +11,11 @@ pub trait LightSelection: Send + Sync {
     /// Per-shading-point state (e.g. a light cut), computed once and shared by `pick` and `pmf`.
     type State;
     fn prepare(&self, scene: &Scene, sp: &ShadingPoint) -> Self::State;
+    /// Number of parts (clusters) the selection splits the lights into at this shading point;
+    /// 0 for single-sample selection.
+    fn clusters(&self, _state: &Self::State) -> usize {
+        0
+    }
     /// Appends (light, probability of choosing it within its part).
     fn pick(
         &self,

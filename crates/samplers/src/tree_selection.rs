@@ -1,13 +1,29 @@
 //! Light-tree selection (Conty Estevez & Kulla 2018): a single stochastic descent, or
 //! adaptive splitting into a cut with one light drawn per cluster.
+use crate::memo::NodeMemo;
+use crate::scratch::Pooled;
 use crate::selection::LightSelection;
-use light_tree::{Cut, LightBounds, LightTree, Rescaled};
+use light_tree::{Cut, LightBounds, LightTree, NodeId, Rescaled, SplitParams};
+use render_core::Vec3;
 use render_core::estimator::ShadingPoint;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
+use std::cell::RefCell;
+use std::collections::VecDeque;
+
+/// The unit of the power the tree aggregates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PowerUnits {
+    /// Watts, one unit for every kind of light ([`render_core::light::Light::power`]).
+    #[default]
+    Watts,
+    /// The authors' `LeWithArea` (`--reproduce`): luminance × area for area lights (no π,
+    /// one side), the intensity's luminance for point and spot lights.
+    Authors,
+}
 
 /// The bounds the tree is built over, one per scene light, in scene order.
-pub fn light_bounds(scene: &Scene) -> Vec<LightBounds> {
+pub fn light_bounds(scene: &Scene, units: PowerUnits) -> Vec<LightBounds> {
     scene
         .lights
         .iter()
@@ -20,7 +36,10 @@ pub fn light_bounds(scene: &Scene) -> Vec<LightBounds> {
                 axis,
                 theta_o,
                 theta_e,
-                power: l.power(),
+                power: match units {
+                    PowerUnits::Watts => l.power(),
+                    PowerUnits::Authors => l.power_authors(),
+                },
                 two_sided: l.two_sided,
             }
         })
@@ -33,8 +52,8 @@ pub enum TreeMode {
     /// One descent from the root.
     Single,
     /// Split nodes whose importance estimate is unreliable (E&K's normalised variance below
-    /// `tau`, or the point inside the node's bounds), up to `max_cut` clusters.
-    Split { tau: f32, max_cut: usize },
+    /// τ, or the point inside the node's bounds); see [`LightTree::adaptive_cut`].
+    Split(SplitParams),
 }
 
 pub struct TreeSelection {
@@ -43,8 +62,8 @@ pub struct TreeSelection {
 }
 
 impl TreeSelection {
-    pub fn new(scene: &Scene, mode: TreeMode) -> Result<TreeSelection, String> {
-        let bounds = light_bounds(scene);
+    pub fn new(scene: &Scene, mode: TreeMode, units: PowerUnits) -> Result<TreeSelection, String> {
+        let bounds = light_bounds(scene, units);
         let tree = if bounds.is_empty() {
             None
         } else {
@@ -54,40 +73,96 @@ impl TreeSelection {
     }
 }
 
-impl LightSelection for TreeSelection {
-    /// The cut for splitting; unused for a single descent.
-    type State = Option<Cut>;
+/// The per-thread buffers of one shading point: the adaptive cut and the importance memo.
+#[derive(Default)]
+pub struct TreeScratch {
+    cut: Cut,
+    queue: VecDeque<NodeId>,
+    memo: RefCell<NodeMemo>,
+}
 
-    fn prepare(&self, _: &Scene, sp: &ShadingPoint) -> Option<Cut> {
-        match (&self.tree, self.mode) {
-            (Some(t), TreeMode::Split { tau, max_cut }) => {
-                Some(t.adaptive_cut(sp.point(), sp.bsdf.ng, tau, max_cut))
+crate::scratch_pool!(TreeScratch, |s| {
+    s.cut.nodes.clear();
+    s.queue.clear();
+    s.memo.get_mut().invalidate();
+});
+
+/// The E&K cut of one shading point (none for a single descent) and its memoised node
+/// importances (shared by the picks and every pmf replay), in per-thread scratch.
+pub struct TreeState {
+    scratch: Pooled<TreeScratch>,
+    split: bool,
+    x: Vec3,
+    n: Vec3,
+}
+
+impl TreeState {
+    /// The cut's nodes (sorted DFS ids), if the selection splits.
+    pub fn cut(&self) -> Option<&Cut> {
+        self.split.then_some(&self.scratch.cut)
+    }
+
+    /// E&K importance of `node` at this shading point (memoised).
+    #[inline]
+    pub fn importance(&self, tree: &LightTree, node: NodeId) -> f32 {
+        let (x, n) = (self.x, self.n);
+        self.scratch
+            .memo
+            .borrow_mut()
+            .get_or(node, |id| tree.importance(id, x, n))
+    }
+}
+
+impl LightSelection for TreeSelection {
+    type State = TreeState;
+
+    fn prepare(&self, _: &Scene, sp: &ShadingPoint) -> TreeState {
+        let mut scratch = Pooled::<TreeScratch>::take();
+        let (x, n) = (sp.point(), sp.bsdf.ng);
+        let split = match (&self.tree, self.mode) {
+            (Some(t), TreeMode::Split(params)) => {
+                let TreeScratch { cut, queue, .. } = &mut *scratch;
+                t.adaptive_cut_into(cut, queue, x, n, &params);
+                true
             }
-            _ => None,
+            _ => false,
+        };
+        TreeState {
+            scratch,
+            split,
+            x,
+            n,
         }
+    }
+
+    fn clusters(&self, state: &TreeState) -> usize {
+        state.cut().map_or(0, Cut::len)
     }
 
     fn pick(
         &self,
-        cut: &Option<Cut>,
-        sp: &ShadingPoint,
+        state: &TreeState,
+        _: &ShadingPoint,
         rng: &mut SampleStream,
         picks: &mut Vec<(u32, f32)>,
     ) {
         let Some(tree) = &self.tree else { return };
-        let (x, n) = (sp.point(), sp.bsdf.ng);
-        match cut {
+        let imp = |c| state.importance(tree, c);
+        match state.cut() {
             None => {
-                if let Some((light, pmf)) = tree.sample(x, n, rng.next_f32()) {
+                let root = tree.root();
+                if let Some((light, pmf)) =
+                    tree.sample_subtree(root, imp, &mut Rescaled(rng.next_f32()))
+                {
                     picks.push((light as u32, pmf));
                 }
             }
             Some(cut) => {
+                // One fresh random number per cluster, rescaled down its subtree (as E&K and
+                // the authors' code).
                 for &node in &cut.nodes {
                     let mut u = Rescaled(rng.next_f32());
-                    if let Some((light, pmf)) =
-                        tree.sample_subtree(node, |c| tree.importance(c, x, n), &mut u)
-                    {
+                    if let Some((light, pmf)) = tree.sample_subtree(node, imp, &mut u) {
                         picks.push((light as u32, pmf));
                     }
                 }
@@ -95,15 +170,13 @@ impl LightSelection for TreeSelection {
         }
     }
 
-    fn pmf(&self, cut: &Option<Cut>, sp: &ShadingPoint, light: u32) -> f32 {
+    fn pmf(&self, state: &TreeState, _: &ShadingPoint, light: u32) -> f32 {
         let Some(tree) = &self.tree else { return 0.0 };
-        let (x, n) = (sp.point(), sp.bsdf.ng);
-        match cut {
-            None => tree.pmf(x, n, light as usize),
+        let imp = |c| state.importance(tree, c);
+        match state.cut() {
+            None => tree.pmf_subtree(tree.root(), imp, light as usize),
             Some(cut) => match cut.cluster_of(tree, light as usize) {
-                Some(k) => {
-                    tree.pmf_subtree(cut.nodes[k], |c| tree.importance(c, x, n), light as usize)
-                }
+                Some(k) => tree.pmf_subtree(cut.nodes[k], imp, light as usize),
                 None => 0.0,
             },
         }

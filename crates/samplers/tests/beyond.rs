@@ -14,7 +14,7 @@ use samplers::ris::candidates::CandidateSource;
 use samplers::ris::resample;
 use samplers::ris::strategy::Ris;
 use samplers::selection::LightSelection;
-use samplers::tree_selection::{TreeMode, TreeSelection};
+use samplers::tree_selection::{PowerUnits, TreeMode, TreeSelection};
 
 /// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
 fn shading_points(scene: &Scene) -> Vec<ShadingPoint> {
@@ -106,7 +106,9 @@ fn oracle_selection_matches_its_pmf_chi2() {
 fn ris_strategy(scene: &Scene) -> Ris<Sptd> {
     Ris {
         name: "ris".into(),
-        tree: TreeSelection::new(scene, TreeMode::Single).unwrap().tree,
+        tree: TreeSelection::new(scene, TreeMode::Single, PowerUnits::Watts)
+            .unwrap()
+            .tree,
         integral: Sptd::default(),
         count: CandidateCount::Fixed(8),
         delta: 0.5,
@@ -213,6 +215,6 @@ fn adaptive_candidate_count_follows_the_bo_upper_bound() {
     let scene = common::mixed_scene(40);
     let ris = ris_strategy(&scene);
     let sp = shading_points(&scene)[0];
-    let ub = ris.bo_state(&sp).unwrap().cut.upper_bound();
+    let ub = ris.bo_state(&sp).unwrap().cut().upper_bound();
     assert!(ub > 0.0 && ub <= 1.0);
 }

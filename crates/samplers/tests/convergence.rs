@@ -17,7 +17,27 @@ fn render_sized(
     seed: u64,
     size: Option<(u32, u32)>,
 ) -> RenderResult {
-    let strategy = create(name, scene, &StrategyOptions::default()).unwrap();
+    render_opts(
+        scene,
+        name,
+        &StrategyOptions::default(),
+        spp,
+        threads,
+        seed,
+        size,
+    )
+}
+
+fn render_opts(
+    scene: &Scene,
+    name: &str,
+    opts: &StrategyOptions,
+    spp: u32,
+    threads: usize,
+    seed: u64,
+    size: Option<(u32, u32)>,
+) -> RenderResult {
+    let strategy = create(name, scene, opts).unwrap();
     let mut camera = scene.camera(None).unwrap();
     if let Some((w, h)) = size {
         camera.width = w;
@@ -114,6 +134,27 @@ fn ris_image_is_identical_for_any_thread_count() {
     }
 }
 
+/// `--reproduce` (the authors' power units, σ and uncapped cut) changes which lights the tree
+/// strategies pick, never what they converge to.
+#[test]
+fn reproduce_tree_strategies_agree_with_the_default() {
+    let scene = common::mixed_scene(40);
+    let reference = render_with(&scene, "power+bsdf", 256, 2, 1);
+    let reproduce = StrategyOptions {
+        reproduce: true,
+        ..Default::default()
+    };
+    for (name, spp) in [("tree+bsdf", 256), ("tree-split+bsdf", 128)] {
+        let r = render_opts(&scene, name, &reproduce, spp, 2, 3, None);
+        let failures = compare(&reference, &r, 2, 3.0);
+        assert!(
+            failures.is_empty(),
+            "{name} --reproduce vs power+bsdf:\n{}",
+            failures.join("\n")
+        );
+    }
+}
+
 #[test]
 fn image_is_identical_for_any_thread_count() {
     let scene = common::mixed_scene(10);
@@ -128,6 +169,19 @@ fn image_is_identical_for_any_thread_count() {
     assert_eq!(a.counters, b.counters);
     let c = render_with(&scene, "power+bsdf", 4, 2, 8);
     assert!(a.pixels != c.pixels, "another seed gives another image");
+    // The strategies with per-thread scratch (cuts, memoised importances) too.
+    for name in ["tree-split+bsdf", "mis3-adaptive"] {
+        let a = render_with(&scene, name, 2, 1, 7);
+        let b = render_with(&scene, name, 2, 2, 7);
+        assert!(
+            a.pixels
+                .iter()
+                .zip(&b.pixels)
+                .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits)),
+            "{name}"
+        );
+        assert_eq!(a.counters, b.counters, "{name}");
+    }
 }
 
 /// The authors' Cornell box read from their own pbrt-v3 files renders like our glTF of it

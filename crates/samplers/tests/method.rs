@@ -3,6 +3,7 @@
 mod common;
 use brdf_integrals::{CapIntegral, Sptd};
 use chi2_test::{chi2_directions, chi2_test};
+use light_tree::{SplitCriterion, SplitParams};
 use render_core::Vec3;
 use render_core::estimator::{PIXEL_MEMORY, SampleContext, ShadingPoint};
 use render_core::render::{RenderResult, RenderSettings, render, shading_point};
@@ -14,7 +15,7 @@ use samplers::brdf_oriented::pivot_sphere::PivotSphere;
 use samplers::brdf_oriented::technique::BoState;
 use samplers::convergence::compare;
 use samplers::selection::LightSelection;
-use samplers::tree_selection::{TreeMode, TreeSelection};
+use samplers::tree_selection::{PowerUnits, TreeMode, TreeSelection};
 use samplers::{StrategyOptions, create};
 
 fn render_opts(
@@ -120,7 +121,13 @@ fn reproduce_mode_and_bo_alone_run() {
         reproduce: true,
         ..Default::default()
     };
-    for name in ["brdf-oriented", "mis3-equal", "mis3-adaptive"] {
+    for name in [
+        "brdf-oriented",
+        "mis3-equal",
+        "mis3-adaptive",
+        "tree",
+        "tree-split+bsdf",
+    ] {
         let r = render_opts(&scene, name, &opts, 2, 3, None);
         assert!(r.pixels.iter().all(|p| p.is_finite()), "{name}");
     }
@@ -133,6 +140,44 @@ fn reproduce_mode_and_bo_alone_run() {
         None,
     );
     assert!(r.pixels.iter().any(|p| p.x > 0.0));
+}
+
+/// `--stats`' light-selection counters: LS clusters everywhere, BO clusters and the extra
+/// BRDF-aware samples only at glossy points, the authors' uncapped cut under `--reproduce`.
+#[test]
+fn selection_counters_are_recorded() {
+    let scene = common::mixed_scene(40);
+    let d = StrategyOptions::default();
+    let r = render_opts(&scene, "mis3-adaptive", &d, 2, 3, Some((24, 18)));
+    let c = &r.counters;
+    assert!(
+        c.glossy_points > 0 && c.glossy_points < c.shading_points,
+        "{c:?}"
+    );
+    assert!(c.ls_clusters >= c.shading_points);
+    assert!(c.ls_clusters_glossy <= c.ls_clusters);
+    assert!(c.bo_clusters >= c.glossy_points);
+    // Diffuse points take one BRDF sample, glossy ones at least one BO and one BRDF sample.
+    assert!(c.brdf_aware_samples_glossy >= 2 * c.glossy_points);
+    assert_eq!(
+        c.brdf_aware_samples - c.brdf_aware_samples_glossy,
+        c.shading_points - c.glossy_points
+    );
+    let e = render_opts(&scene, "tree-split+bsdf", &d, 2, 3, Some((24, 18))).counters;
+    assert_eq!(e.bo_clusters, 0);
+    assert_eq!(e.brdf_aware_samples, e.shading_points);
+    assert!(e.ls_clusters >= e.shading_points);
+    let p = StrategyOptions {
+        reproduce: true,
+        ..d.clone()
+    }
+    .split_params();
+    assert_eq!(p.max_size, usize::MAX);
+    assert_eq!(p.criterion, light_tree::SplitCriterion::Authors);
+    assert_eq!(
+        d.split_params().criterion,
+        light_tree::SplitCriterion::UnitFree
+    );
 }
 
 /// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
@@ -175,10 +220,12 @@ fn every_technique_pdf_at_sampling_equals_its_replay() {
     let scene = common::mixed_scene(40);
     let sel = TreeSelection::new(
         &scene,
-        TreeMode::Split {
+        TreeMode::Split(SplitParams {
             tau: 0.85,
-            max_cut: 64,
-        },
+            max_size: 64,
+            criterion: SplitCriterion::Authors,
+        }),
+        PowerUnits::Watts,
     )
     .unwrap();
     let tree = sel.tree.as_ref().unwrap();
@@ -189,7 +236,7 @@ fn every_technique_pdf_at_sampling_equals_its_replay() {
         let x = sp.point();
         for pivot in [false, true] {
             let bo = bo_state(&sel, sp, pivot);
-            assert!(!bo.cut.cut.is_empty());
+            assert!(!bo.cut().cut.is_empty());
             let mut checked = 0;
             for i in 0..2000 {
                 let mut rng = SampleStream::new(5, 0, i);
@@ -238,10 +285,12 @@ fn bo_selection_matches_its_pmf_chi2() {
     let scene = common::mixed_scene(40);
     let sel = TreeSelection::new(
         &scene,
-        TreeMode::Split {
+        TreeMode::Split(SplitParams {
             tau: 0.85,
-            max_cut: 64,
-        },
+            max_size: 64,
+            criterion: SplitCriterion::Authors,
+        }),
+        PowerUnits::Watts,
     )
     .unwrap();
     let tree = sel.tree.as_ref().unwrap();
@@ -279,10 +328,12 @@ fn pivot_sphere_sampling_matches_its_pdf_chi2() {
     let scene = common::mixed_scene(40);
     let sel = TreeSelection::new(
         &scene,
-        TreeMode::Split {
+        TreeMode::Split(SplitParams {
             tau: 0.85,
-            max_cut: 64,
-        },
+            max_size: 64,
+            criterion: SplitCriterion::Authors,
+        }),
+        PowerUnits::Watts,
     )
     .unwrap();
     let sp = shading_points(&scene)[0];

@@ -6,6 +6,13 @@ use brdf_integrals::LobeIntegral;
 use light_tree::{Cut, LightTree, NodeId};
 use std::collections::VecDeque;
 
+/// Buffers of [`BoCut::build_into`].
+#[derive(Clone, Debug, Default)]
+pub struct BoCutScratch {
+    out: Vec<(NodeId, NodeTerms)>,
+    queue: VecDeque<NodeId>,
+}
+
 /// A BO cut: node ids sorted by DFS id with their terms and the cumulative importance.
 #[derive(Clone, Debug, Default)]
 pub struct BoCut {
@@ -16,14 +23,30 @@ pub struct BoCut {
 }
 
 impl BoCut {
+    /// Builds the BO cut of the shading point of `rec` (at most `max_size` nodes).
     pub fn build<L: LobeIntegral + LobeDensity>(
         tree: &LightTree,
         rec: &BoRecord<L>,
         delta: f32,
         max_size: usize,
     ) -> BoCut {
-        let mut out: Vec<(NodeId, NodeTerms)> = Vec::new();
-        let mut queue = VecDeque::new();
+        let mut cut = BoCut::default();
+        cut.build_into(tree, rec, delta, max_size, &mut BoCutScratch::default());
+        cut
+    }
+
+    /// [`BoCut::build`] into `self`, reusing its buffers and the caller's scratch.
+    pub fn build_into<L: LobeIntegral + LobeDensity>(
+        &mut self,
+        tree: &LightTree,
+        rec: &BoRecord<L>,
+        delta: f32,
+        max_size: usize,
+        scratch: &mut BoCutScratch,
+    ) {
+        let BoCutScratch { out, queue } = scratch;
+        out.clear();
+        queue.clear();
         queue.push_back(tree.root());
         let mut size = 1usize;
         while let Some(id) = queue.pop_front() {
@@ -50,18 +73,15 @@ impl BoCut {
             }
         }
         out.sort_unstable_by_key(|&(id, _)| id);
-        let mut cdf = Vec::with_capacity(out.len());
+        self.cut.nodes.clear();
+        self.terms.clear();
+        self.cdf.clear();
         let mut acc = 0.0f32;
-        for &(_, t) in &out {
+        for &(id, t) in out.iter() {
             acc += t.importance;
-            cdf.push(acc);
-        }
-        BoCut {
-            cut: Cut {
-                nodes: out.iter().map(|&(id, _)| id).collect(),
-            },
-            terms: out.into_iter().map(|(_, t)| t).collect(),
-            cdf,
+            self.cut.nodes.push(id);
+            self.terms.push(t);
+            self.cdf.push(acc);
         }
     }
 

@@ -41,6 +41,18 @@ pub struct BoRecord<L> {
     /// Use the lobe density at the axis for small caps or caps far from the lobe's peak
     /// (see `point_estimate`); off in `reproduce`.
     pub point_approx: bool,
+    /// The lobe's peak, precomputed for `point_estimate` (None without a peak).
+    peak: Option<PeakBound>,
+}
+
+/// The lobe's peak direction and angular width w, with cos 3w and sin 3w, so that the test
+/// "the cap lies farther than 3w from the peak" needs no inverse trigonometry per node.
+#[derive(Clone, Copy, Debug)]
+struct PeakBound {
+    dir: Vec3,
+    width: f32,
+    cos3w: f32,
+    sin3w: f32,
 }
 
 /// A node's BO terms at a shading point.
@@ -89,7 +101,14 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
         } else {
             p.specular.tint()
         };
+        let peak = lobe.peak().map(|(dir, width)| PeakBound {
+            dir,
+            width,
+            cos3w: (3.0 * width).cos(),
+            sin3w: (3.0 * width).sin(),
+        });
         BoRecord {
+            peak,
             point_approx: !oat_sander,
             x: sp.point(),
             frame: sp.bsdf.frame,
@@ -168,12 +187,16 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
         if !self.point_approx || sin2 > 0.0606 || axis.z * axis.z <= sin2 || axis.z <= 0.0 {
             return None;
         }
-        let (peak, width) = self.lobe.peak()?;
-        let narrow = sin2 < (0.25 * width) * (0.25 * width);
-        // angle(axis, peak) > σ + 3·width  ⇔  cos(angle) < cos(σ + 3·width)
+        let pk = self.peak?;
+        let narrow = sin2 < (0.25 * pk.width) * (0.25 * pk.width);
+        // angle(axis, peak) > σ + 3w with sin σ = s: for σ + 3w < π this is
+        // cos(angle) < cos(σ + 3w) = cos σ·cos 3w − s·sin 3w, and σ + 3w < π ⇔ 3w ≤ π/2 or
+        // s < sin 3w (σ ≤ π/2 here).
         let far = {
-            let reach = sin2.sqrt().asin() + 3.0 * width;
-            reach < std::f32::consts::PI && axis.dot(peak) < reach.cos()
+            let s = sin2.sqrt();
+            let cos_sigma = (1.0 - sin2).max(0.0).sqrt();
+            let below_pi = pk.cos3w >= 0.0 || s < pk.sin3w;
+            below_pi && axis.dot(pk.dir) < cos_sigma * pk.cos3w - s * pk.sin3w
         };
         if narrow || far {
             self.lobe.density(axis)

@@ -10,6 +10,7 @@ use super::{BoConfig, LobePivot};
 use crate::bsdf_sampling::sample_bsdf;
 use crate::light_strategy::sample_pick;
 use crate::mis::power_heuristic;
+use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
 use brdf_integrals::CapIntegral;
@@ -42,6 +43,17 @@ pub struct Mis3<C: CapIntegral> {
     pub config: BoConfig,
 }
 
+/// Per-thread buffers of one shading point: the LS picks and the samples taken.
+#[derive(Default)]
+pub struct Mis3Scratch {
+    taken: Vec<Taken>,
+    picks: Vec<(u32, f32)>,
+}
+crate::scratch_pool!(Mis3Scratch, |s| {
+    s.taken.clear();
+    s.picks.clear();
+});
+
 /// A sample with a non-zero unweighted contribution: technique, f·L (shadowed), and the densities
 /// of the three techniques at its light point.
 #[derive(Clone, Copy, Debug)]
@@ -72,6 +84,22 @@ where
             self.config.max_cut_bo,
             pivot,
         ))
+    }
+}
+
+impl<C: CapIntegral> Mis3<C> {
+    /// P(BO) of the default allocation, fixed before drawing from the hit/miss tallies of the
+    /// pixel's earlier samples (heuristic 2), or 1/2 with the heuristic off.
+    fn planned_p_bo(&self, ctx: &SampleContext) -> f32 {
+        if self.config.adaptive_split {
+            probability_bo(
+                ctx.pixel_memory[SLOT_HITS],
+                ctx.pixel_memory[SLOT_MISSES],
+                self.config.lambda,
+            )
+        } else {
+            0.5
+        }
     }
 }
 
@@ -119,6 +147,8 @@ where
                 return Vec3::ZERO;
             };
             ctx.counters.technique_samples[0] += 1;
+            ctx.counters
+                .record_selection(!sp.bsdf.is_pure_diffuse(), 0, bo.cut().cut.len(), 1);
             let Some((light, p_sel)) = bo.select(tree, rng, fresh) else {
                 return Vec3::ZERO;
             };
@@ -164,12 +194,12 @@ where
                 };
                 [p_ls, p_bo, p_bsdf]
             };
-        let mut taken: Vec<Taken> = Vec::new();
+        let mut scratch = Pooled::<Mis3Scratch>::take();
+        let Mis3Scratch { taken, picks } = &mut *scratch;
 
         // LS: one light per cluster of the E&K cut (a splitting technique counts as one sample).
-        let mut picks = Vec::new();
-        self.ls.pick(&ls_state, sp, rng, &mut picks);
-        for &(light, pmf) in &picks {
+        self.ls.pick(&ls_state, sp, rng, picks);
+        for &(light, pmf) in picks.iter() {
             ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
             let Some((s, p_ls, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters) else {
                 continue;
@@ -259,59 +289,54 @@ where
 
         let (n_bo, n_brdf, n_extra) = match (&bo, self.mode) {
             (None, _) => {
-                bsdf_sample(&mut taken, rng, ctx);
+                bsdf_sample(taken, rng, ctx);
                 (0, 1, 0)
             }
             (Some(_), Mis3Mode::Equal) => {
-                bo_sample(&mut taken, rng, ctx);
-                bsdf_sample(&mut taken, rng, ctx);
+                bo_sample(taken, rng, ctx);
+                bsdf_sample(taken, rng, ctx);
                 (1, 1, 0)
             }
             (Some(b), _) => {
                 let n = total_brdf_aware(
-                    b.cut.upper_bound(),
+                    b.cut().upper_bound(),
                     self.config.n_max,
                     self.config.adaptive_total,
                 );
                 if self.config.reproduce {
-                    // The authors' in-sample loop (biased: the outcomes pick the counts).
+                    // The authors' in-sample loop (biased: the outcomes pick the counts), with
+                    // their one random number rescaled at every step.
                     let mut c = InSampleCounters::new(self.config.lambda);
-                    bo_sample(&mut taken, rng, ctx);
-                    c.record(bsdf_sample(&mut taken, rng, ctx));
+                    bo_sample(taken, rng, ctx);
+                    c.record(bsdf_sample(taken, rng, ctx));
                     let (mut n_bo, mut n_brdf) = (1, 1);
+                    let mut u = rng.next_f32();
                     for _ in 0..n {
                         let p = if self.config.adaptive_split {
                             c.p_bo()
                         } else {
                             0.5
                         };
-                        if rng.next_f32() < p {
-                            bo_sample(&mut taken, rng, ctx);
+                        if u < p {
+                            bo_sample(taken, rng, ctx);
                             n_bo += 1;
+                            u /= p;
                         } else {
-                            c.record(bsdf_sample(&mut taken, rng, ctx));
+                            c.record(bsdf_sample(taken, rng, ctx));
                             n_brdf += 1;
+                            u = (u - p) / (1.0 - p);
                         }
                     }
                     (n_bo, n_brdf, n)
                 } else {
                     // Counts fixed before drawing, from earlier samples of this pixel.
-                    let p = if self.config.adaptive_split {
-                        probability_bo(
-                            ctx.pixel_memory[SLOT_HITS],
-                            ctx.pixel_memory[SLOT_MISSES],
-                            self.config.lambda,
-                        )
-                    } else {
-                        0.5
-                    };
-                    let (n_bo, n_brdf) = fixed_counts(n, p);
+                    let (n_bo, n_brdf) = fixed_counts(n, self.planned_p_bo(ctx));
                     for _ in 0..n_bo {
-                        bo_sample(&mut taken, rng, ctx);
+                        bo_sample(taken, rng, ctx);
                     }
                     let mut hits = 0u32;
                     for _ in 0..n_brdf {
-                        hits += bsdf_sample(&mut taken, rng, ctx) as u32;
+                        hits += bsdf_sample(taken, rng, ctx) as u32;
                     }
                     ctx.pixel_memory[SLOT_HITS] += hits as f32;
                     ctx.pixel_memory[SLOT_MISSES] += (n_brdf - hits) as f32;
@@ -319,6 +344,12 @@ where
                 }
             }
         };
+        ctx.counters.record_selection(
+            bo.is_some(),
+            self.ls.clusters(&ls_state),
+            bo.as_ref().map_or(0, |b| b.cut().cut.len()),
+            (n_bo + n_brdf) as usize,
+        );
         ctx.aux[0] = n_extra as f32;
         ctx.aux[1] = if n_bo + n_brdf > 0 {
             n_bo as f32 / (n_bo + n_brdf) as f32
@@ -328,7 +359,7 @@ where
 
         let counts = [1.0f32, n_bo as f32, n_brdf as f32];
         let mut l = Vec3::ZERO;
-        for t in &taken {
+        for t in taken.iter() {
             let techniques = [
                 (counts[0], t.p[0]),
                 (counts[1], t.p[1]),

@@ -1,8 +1,10 @@
 //! BRDF-oriented light sampling (BO) at one shading point: pick a cluster of the BO cut by
 //! I_BO, descend inside it by I_BO, sample a point on the light; and the pdf of any light point.
-use super::cut::BoCut;
+use super::cut::{BoCut, BoCutScratch};
 use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
+use crate::memo::NodeMemo;
+use crate::scratch::Pooled;
 use brdf_integrals::LobeIntegral;
 use light_tree::{Fresh, LightTree, NodeId, Rescaled};
 use render_core::Vec3;
@@ -10,33 +12,30 @@ use render_core::light::{Light, LightSample};
 use render_core::rng::SampleStream;
 use std::cell::RefCell;
 
-const MEMO_SIZE: usize = 4096;
-
-/// Direct-mapped cache of node importances of one shading point. Importance is a pure function
-/// of (node, shading point), so a cached value is bit-identical to a recomputed one and the
-/// sampling and the pdf replay stay consistent.
-struct Memo {
-    slots: Box<[(NodeId, f32); MEMO_SIZE]>,
+/// Per-thread buffers of one shading point's BO state: the cut, its build scratch and the
+/// importance memo.
+#[derive(Default)]
+pub struct BoScratch {
+    cut: BoCut,
+    build: BoCutScratch,
+    memo: RefCell<NodeMemo>,
 }
 
-impl Memo {
-    fn new() -> Memo {
-        Memo {
-            slots: Box::new([(NodeId::MAX, 0.0); MEMO_SIZE]),
-        }
-    }
-}
+crate::scratch_pool!(BoScratch, |s| s.memo.get_mut().invalidate());
 
-/// Per-shading-point BO state.
+/// Per-shading-point BO state: the record, the BO cut with its cluster distribution, and the
+/// memoised node importances shared by sampling and pdf evaluation. Its buffers are on loan
+/// from a per-thread pool (no allocation per shading point).
 pub struct BoState<L> {
     pub rec: BoRecord<L>,
-    pub cut: BoCut,
-    memo: RefCell<Memo>,
+    scratch: Pooled<BoScratch>,
     /// Pivot-sphere point sampling (method.md §3.1), if enabled.
     pub pivot: Option<PivotSphere>,
 }
 
 impl<L: LobeIntegral + LobeDensity> BoState<L> {
+    /// Builds the BO cut of the shading point of `rec` (split while the cap integral > `delta`,
+    /// at most `max_cut` clusters).
     pub fn new(
         tree: &LightTree,
         rec: BoRecord<L>,
@@ -44,58 +43,62 @@ impl<L: LobeIntegral + LobeDensity> BoState<L> {
         max_cut: usize,
         pivot: Option<PivotSphere>,
     ) -> Self {
-        let cut = BoCut::build(tree, &rec, delta, max_cut);
+        let mut scratch = Pooled::<BoScratch>::take();
+        let BoScratch { cut, build, .. } = &mut *scratch;
+        cut.build_into(tree, &rec, delta, max_cut, build);
         BoState {
             rec,
-            cut,
-            memo: RefCell::new(Memo::new()),
+            scratch,
             pivot,
         }
     }
 
-    /// I_BO of `id` (memoised).
-    pub fn importance(&self, tree: &LightTree, id: NodeId) -> f32 {
-        let slot = (id.wrapping_mul(0x9E37_79B1) >> 20) as usize % MEMO_SIZE;
-        {
-            let m = self.memo.borrow();
-            if m.slots[slot].0 == id {
-                return m.slots[slot].1;
-            }
-        }
-        let v = self.rec.terms(tree.node(id)).importance;
-        self.memo.borrow_mut().slots[slot] = (id, v);
-        v
+    /// The BO cut: clusters (sorted DFS ids), their terms and the cluster cdf.
+    #[inline]
+    pub fn cut(&self) -> &BoCut {
+        &self.scratch.cut
     }
 
-    /// Chooses a light: `(light, selection probability)`. `fresh`: a fresh random number per
-    /// tree level (default); otherwise the cluster's `u` is rescaled down the tree (authors).
+    /// I_BO of `id` (memoised).
+    pub fn importance(&self, tree: &LightTree, id: NodeId) -> f32 {
+        self.scratch
+            .memo
+            .borrow_mut()
+            .get_or(id, |id| self.rec.terms(tree.node(id)).importance)
+    }
+
+    /// Chooses a light: `(light, selection probability)`: a cluster by I_BO, then a descent by
+    /// I_BO. `fresh`: a fresh random number per tree level (default); otherwise one fresh
+    /// number after the cluster choice, rescaled down the tree (the authors' code).
     pub fn select(
         &self,
         tree: &LightTree,
         rng: &mut SampleStream,
         fresh: bool,
     ) -> Option<(usize, f32)> {
-        let (k, p_cl, rest) = self.cut.pick(rng.next_f32())?;
-        let start = self.cut.cut.nodes[k];
+        let cut = self.cut();
+        let (k, p_cl, _) = cut.pick(rng.next_f32())?;
+        let start = cut.cut.nodes[k];
         let imp = |c| self.importance(tree, c);
         let (light, p) = if fresh {
             tree.sample_subtree(start, imp, &mut Fresh(|| rng.next_f32()))?
         } else {
-            tree.sample_subtree(start, imp, &mut Rescaled(rest))?
+            tree.sample_subtree(start, imp, &mut Rescaled(rng.next_f32()))?
         };
         Some((light, p_cl * p))
     }
 
     /// Probability that [`BoState::select`] returns `light`.
     pub fn selection_pmf(&self, tree: &LightTree, light: usize) -> f32 {
-        let Some(k) = self.cut.cut.cluster_of(tree, light) else {
+        let cut = self.cut();
+        let Some(k) = cut.cut.cluster_of(tree, light) else {
             return 0.0;
         };
-        let p_cl = self.cut.cluster_pmf(k);
+        let p_cl = cut.cluster_pmf(k);
         if !(p_cl > 0.0) {
             return 0.0;
         }
-        p_cl * tree.pmf_subtree(self.cut.cut.nodes[k], |c| self.importance(tree, c), light)
+        p_cl * tree.pmf_subtree(cut.cut.nodes[k], |c| self.importance(tree, c), light)
     }
 
     /// Samples a point on `light` (its own shape sampling, or the pivot-sphere mixture).

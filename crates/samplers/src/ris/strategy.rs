@@ -113,7 +113,7 @@ where
         let bo = self.bo_state(sp);
         let m = self
             .count
-            .at(bo.as_ref().map_or(0.0, |b| b.cut.upper_bound()));
+            .at(bo.as_ref().map_or(0.0, |b| b.cut().upper_bound()));
         let source = CandidateSource::new(scene, tree, sp, bo.as_ref(), m);
         ctx.aux[0] = m as f32;
 
