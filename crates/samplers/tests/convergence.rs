@@ -206,7 +206,9 @@ fn bisml_cornell_from_pbrt_agrees_with_its_gltf() {
         let settings = RenderSettings {
             width: 32,
             height: 32,
-            spp: Some(32),
+            // 64 spp: the unit-free E&K cut (12 clusters per point here) leaves the wall's hot
+            // spots noisier than 32 spp can bound to 5 % of the mean.
+            spp: Some(64),
             seed,
             time_budget: None,
             threads: Some(2),
