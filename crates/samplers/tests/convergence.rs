@@ -117,20 +117,25 @@ fn oracle_and_ris_agree_with_power_bsdf() {
     }
 }
 
+/// The same pixels bit for bit and the same counters (thread-count determinism).
+fn assert_bit_identical(a: &RenderResult, b: &RenderResult, name: &str) {
+    assert!(
+        a.pixels
+            .iter()
+            .zip(&b.pixels)
+            .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits)),
+        "{name}"
+    );
+    assert_eq!(a.counters, b.counters, "{name}");
+}
+
 #[test]
 fn ris_image_is_identical_for_any_thread_count() {
     let scene = common::mixed_scene(10);
     for name in ["ris", "ris-adaptive"] {
         let a = render_with(&scene, name, 4, 1, 7);
         let b = render_with(&scene, name, 4, 2, 7);
-        assert!(
-            a.pixels
-                .iter()
-                .zip(&b.pixels)
-                .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits)),
-            "{name}"
-        );
-        assert_eq!(a.counters, b.counters, "{name}");
+        assert_bit_identical(&a, &b, name);
     }
 }
 
@@ -160,27 +165,14 @@ fn image_is_identical_for_any_thread_count() {
     let scene = common::mixed_scene(10);
     let a = render_with(&scene, "power+bsdf", 4, 1, 7);
     let b = render_with(&scene, "power+bsdf", 4, 2, 7);
-    assert!(
-        a.pixels
-            .iter()
-            .zip(&b.pixels)
-            .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits))
-    );
-    assert_eq!(a.counters, b.counters);
+    assert_bit_identical(&a, &b, "power+bsdf");
     let c = render_with(&scene, "power+bsdf", 4, 2, 8);
     assert!(a.pixels != c.pixels, "another seed gives another image");
     // The strategies with per-thread scratch (cuts, memoised importances) too.
     for name in ["tree-split+bsdf", "mis3-adaptive"] {
         let a = render_with(&scene, name, 2, 1, 7);
         let b = render_with(&scene, name, 2, 2, 7);
-        assert!(
-            a.pixels
-                .iter()
-                .zip(&b.pixels)
-                .all(|(p, q)| p.to_array().map(f32::to_bits) == q.to_array().map(f32::to_bits)),
-            "{name}"
-        );
-        assert_eq!(a.counters, b.counters, "{name}");
+        assert_bit_identical(&a, &b, name);
     }
 }
 
