@@ -32,8 +32,9 @@ use tree_selection::{PowerUnits, TreeMode, TreeSelection};
 #[derive(Clone, Debug, Serialize, Deserialize)]
 #[serde(default)]
 pub struct StrategyOptions {
-    /// Splitting threshold τ of adaptive tree splitting (Conty Estevez & Kulla; the authors' code uses 0.85).
-    pub tau: f32,
+    /// Splitting threshold τ of adaptive tree splitting (Conty Estevez & Kulla); `None`: the
+    /// mode's default, [`DEFAULT_TAU`] for our unit-free cut, [`AUTHORS_TAU`] under `reproduce`.
+    pub tau: Option<f32>,
     /// Most clusters in an adaptive cut (the E&K cut and the BRDF-oriented cut).
     pub max_cut: usize,
     /// BRDF-oriented cut: split a node when its cap integral exceeds δ (authors: 0.5).
@@ -57,19 +58,34 @@ pub struct StrategyOptions {
     pub adaptive_split: bool,
 }
 
+/// Our default τ for the unit-free E&K cut, chosen by the equal-time sweep of
+/// `experiments/tau.toml` (results/tau/table.md): near-best for E&K and for the method alike.
+pub const DEFAULT_TAU: f32 = 0.35;
+/// The authors' τ (bisml's `LightTreeSampler`), used under `reproduce`.
+pub const AUTHORS_TAU: f32 = 0.85;
+
 impl StrategyOptions {
+    /// τ in effect: the one given, else the mode's default.
+    pub fn tau(&self) -> f32 {
+        self.tau.unwrap_or(if self.reproduce {
+            AUTHORS_TAU
+        } else {
+            DEFAULT_TAU
+        })
+    }
+
     /// The E&K cut's parameters: the authors' σ in scene units and no cap under `reproduce`,
     /// our unit-free σ and `max_cut` otherwise.
     pub fn split_params(&self) -> SplitParams {
         if self.reproduce {
             SplitParams {
-                tau: self.tau,
+                tau: self.tau(),
                 max_size: usize::MAX,
                 criterion: SplitCriterion::Authors,
             }
         } else {
             SplitParams {
-                tau: self.tau,
+                tau: self.tau(),
                 max_size: self.max_cut,
                 criterion: SplitCriterion::UnitFree,
             }
@@ -89,7 +105,7 @@ impl StrategyOptions {
 impl Default for StrategyOptions {
     fn default() -> Self {
         StrategyOptions {
-            tau: 0.85,
+            tau: None,
             max_cut: 64,
             delta: 0.5,
             n_max: 50,
@@ -187,10 +203,11 @@ pub fn create(
             opts.delta, opts.lambda
         )));
     }
-    if opts.max_cut == 0 || !(opts.tau >= 0.0 && opts.tau <= 1.0) {
+    if opts.max_cut == 0 || !(opts.tau() >= 0.0 && opts.tau() <= 1.0) {
         return Err(StrategyError::BadOption(format!(
             "need max_cut ≥ 1 and τ in [0, 1], got max_cut = {}, τ = {}",
-            opts.max_cut, opts.tau
+            opts.max_cut,
+            opts.tau()
         )));
     }
     let units = opts.power_units();
@@ -287,7 +304,7 @@ fn mis3(
         delta: opts.delta,
         n_max: opts.n_max,
         lambda: opts.lambda,
-        tau: opts.tau,
+        tau: opts.tau(),
         max_cut: opts.split_params().max_size,
         max_cut_bo: opts.split_params().max_size,
         brdf_integral: opts.brdf_integral,
