@@ -94,6 +94,9 @@ pub struct MethodArgs {
     /// Turn off heuristic 2 (P(BO) from hits and misses); P(BO) = 1/2 instead.
     #[arg(long)]
     pub no_adaptive_split: bool,
+    /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo).
+    #[arg(long)]
+    pub weighted_ub: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -121,6 +124,7 @@ impl MethodArgs {
             pivot_sphere: self.pivot_sphere,
             adaptive_total: !self.no_adaptive_total,
             adaptive_split: !self.no_adaptive_split,
+            weighted_ub: self.weighted_ub,
         }
     }
 }

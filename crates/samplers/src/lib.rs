@@ -54,6 +54,9 @@ pub struct StrategyOptions {
     pub pivot_sphere: bool,
     /// Heuristic 1: N = floor(N_max·UB); off: N = N_max/2.
     pub adaptive_total: bool,
+    /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo), so that N follows the
+    /// lobe's actual strength (off by default: see README, "weighted UB").
+    pub weighted_ub: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
 }
@@ -114,6 +117,7 @@ impl Default for StrategyOptions {
             reproduce: false,
             pivot_sphere: false,
             adaptive_total: true,
+            weighted_ub: false,
             adaptive_split: true,
         }
     }
@@ -311,6 +315,7 @@ fn mis3(
         reproduce: opts.reproduce,
         pivot_sphere: opts.pivot_sphere,
         adaptive_total: opts.adaptive_total,
+        weighted_ub: opts.weighted_ub,
         adaptive_split: opts.adaptive_split,
     };
     Ok(match opts.brdf_integral {

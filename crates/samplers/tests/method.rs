@@ -72,12 +72,17 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         brdf_integral: samplers::brdf_oriented::BrdfIntegral::Ltc,
         ..d.clone()
     };
+    let weighted_ub = StrategyOptions {
+        weighted_ub: true,
+        ..d.clone()
+    };
     for (name, opts, label) in [
         ("mis3-adaptive", &ltc, "mis3-adaptive --brdf-integral ltc"),
         ("mis3-equal", &d, "mis3-equal"),
         ("mis3-adaptive", &d, "mis3-adaptive"),
         ("mis3-adaptive", &pivot, "mis3-adaptive --pivot-sphere"),
         ("mis3-adaptive", &no_h, "mis3-adaptive without heuristics"),
+        ("mis3-adaptive", &weighted_ub, "mis3-adaptive --weighted-ub"),
     ] {
         let r = render_opts(scene, name, opts, spp, 2, size);
         let failures = compare(&reference, &r, 2, 3.0);

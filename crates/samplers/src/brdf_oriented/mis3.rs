@@ -298,11 +298,14 @@ where
                 (1, 1, 0)
             }
             (Some(b), _) => {
-                let n = total_brdf_aware(
-                    b.cut().upper_bound(),
-                    self.config.n_max,
-                    self.config.adaptive_total,
-                );
+                // Heuristic 1's UB, optionally times the glossy lobe's weight (Ks·F), as the
+                // fidelity issue asks; off by default until it wins at equal time.
+                let ub = if self.config.weighted_ub {
+                    b.cut().upper_bound() * b.rec.ks.min(1.0)
+                } else {
+                    b.cut().upper_bound()
+                };
+                let n = total_brdf_aware(ub, self.config.n_max, self.config.adaptive_total);
                 if self.config.reproduce {
                     // The authors' in-sample loop (biased: the outcomes pick the counts), with
                     // their one random number rescaled at every step.

@@ -70,6 +70,8 @@ pub struct BoConfig {
     pub pivot_sphere: bool,
     /// Heuristic 1 (N from UB); off: N = N_max/2.
     pub adaptive_total: bool,
+    /// Heuristic 1's UB times the glossy lobe's weight (Ks·F at θo).
+    pub weighted_ub: bool,
     /// Heuristic 2 (P(BO) from hit/miss counts); off: P = 1/2.
     pub adaptive_split: bool,
 }
