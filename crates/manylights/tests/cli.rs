@@ -376,6 +376,16 @@ fn mis3_flags_and_false_colour_aux() {
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("adaptive.json")).unwrap()).unwrap();
     assert_eq!(meta["strategy_parameters"]["n_max"], 20);
+    // τ: as given; else ours (0.35), or the authors' 0.85 under --reproduce, so that changing
+    // our default never moves the reproduced baseline.
+    for (name, tau) in [("adaptive", 0.8), ("noh", 0.35), ("repro", 0.85)] {
+        let meta: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap(),
+        )
+        .unwrap();
+        let got = meta["strategy_parameters"]["tau"].as_f64().unwrap();
+        assert!((got - tau).abs() < 1e-6, "{name}: τ {got}, want {tau}");
+    }
     let o = manylights(&[
         "render",
         SCENE,
