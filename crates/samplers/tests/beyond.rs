@@ -5,7 +5,6 @@ use brdf_integrals::Sptd;
 use chi2_test::chi2_test;
 use render_core::Vec3;
 use render_core::estimator::ShadingPoint;
-use render_core::render::shading_point;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use samplers::oracle::OracleSelection;
@@ -18,21 +17,17 @@ use samplers::tree_selection::{PowerUnits, TreeMode, TreeSelection};
 
 /// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
 fn shading_points(scene: &Scene) -> Vec<ShadingPoint> {
-    let cam = Vec3::new(0.0, 1.4, 2.6);
-    [
-        Vec3::new(0.1, 0.0, -0.4),
-        Vec3::new(-0.6, 0.45, 0.0),
-        Vec3::new(-1.2, 0.0, 0.5),
-        Vec3::new(0.9, 0.0, -1.2),
-        Vec3::new(0.6, 0.3, -0.2),
-    ]
-    .iter()
-    .filter_map(|&target| {
-        let d = (target - cam).normalize();
-        let hit = scene.intersect(cam, d, 0.0, f32::INFINITY)?;
-        shading_point(scene, hit, -d)
-    })
-    .collect()
+    common::shading_points_towards(
+        scene,
+        Vec3::new(0.0, 1.4, 2.6),
+        &[
+            Vec3::new(0.1, 0.0, -0.4),
+            Vec3::new(-0.6, 0.45, 0.0),
+            Vec3::new(-1.2, 0.0, 0.5),
+            Vec3::new(0.9, 0.0, -1.2),
+            Vec3::new(0.6, 0.3, -0.2),
+        ],
+    )
 }
 
 /// Chi-square of `draw` (a light index or `None`) against `pmf` over the lights, the missing

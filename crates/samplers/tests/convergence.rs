@@ -17,7 +17,7 @@ fn render_sized(
     seed: u64,
     size: Option<(u32, u32)>,
 ) -> RenderResult {
-    render_opts(
+    common::render_opts(
         scene,
         name,
         &StrategyOptions::default(),
@@ -26,33 +26,6 @@ fn render_sized(
         seed,
         size,
     )
-}
-
-fn render_opts(
-    scene: &Scene,
-    name: &str,
-    opts: &StrategyOptions,
-    spp: u32,
-    threads: usize,
-    seed: u64,
-    size: Option<(u32, u32)>,
-) -> RenderResult {
-    let strategy = create(name, scene, opts).unwrap();
-    let mut camera = scene.camera(None).unwrap();
-    if let Some((w, h)) = size {
-        camera.width = w;
-        camera.height = h;
-    }
-    let settings = RenderSettings {
-        width: camera.width,
-        height: camera.height,
-        spp: Some(spp),
-        seed,
-        time_budget: None,
-        threads: Some(threads),
-        camera,
-    };
-    render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
 }
 
 #[test]
@@ -150,7 +123,7 @@ fn reproduce_tree_strategies_agree_with_the_default() {
         ..Default::default()
     };
     for (name, spp) in [("tree+bsdf", 256), ("tree-split+bsdf", 128)] {
-        let r = render_opts(&scene, name, &reproduce, spp, 2, 3, None);
+        let r = common::render_opts(&scene, name, &reproduce, spp, 2, 3, None);
         let failures = compare(&reference, &r, 2, 3.0);
         assert!(
             failures.is_empty(),

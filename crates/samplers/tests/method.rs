@@ -6,7 +6,7 @@ use chi2_test::{chi2_directions, chi2_test};
 use light_tree::{SplitCriterion, SplitParams};
 use render_core::Vec3;
 use render_core::estimator::{PIXEL_MEMORY, SampleContext, ShadingPoint};
-use render_core::render::{RenderResult, RenderSettings, render, shading_point};
+use render_core::render::RenderResult;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
@@ -18,6 +18,7 @@ use samplers::selection::LightSelection;
 use samplers::tree_selection::{PowerUnits, TreeMode, TreeSelection};
 use samplers::{StrategyOptions, create};
 
+/// [`common::render_opts`] on two threads.
 fn render_opts(
     scene: &Scene,
     name: &str,
@@ -26,22 +27,7 @@ fn render_opts(
     seed: u64,
     size: Option<(u32, u32)>,
 ) -> RenderResult {
-    let strategy = create(name, scene, opts).unwrap();
-    let mut camera = scene.camera(None).unwrap();
-    if let Some((w, h)) = size {
-        camera.width = w;
-        camera.height = h;
-    }
-    let settings = RenderSettings {
-        width: camera.width,
-        height: camera.height,
-        spp: Some(spp),
-        seed,
-        time_budget: None,
-        threads: Some(2),
-        camera,
-    };
-    render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
+    common::render_opts(scene, name, opts, spp, 2, seed, size)
 }
 
 fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32, spp: u32) {
@@ -187,20 +173,16 @@ fn selection_counters_are_recorded() {
 
 /// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
 fn shading_points(scene: &Scene) -> Vec<ShadingPoint> {
-    let cam = Vec3::new(0.0, 1.4, 2.6);
-    [
-        Vec3::new(0.1, 0.0, -0.4),
-        Vec3::new(-0.6, 0.45, 0.0),
-        Vec3::new(-1.2, 0.0, 0.5),
-        Vec3::new(0.9, 0.0, -1.2),
-    ]
-    .iter()
-    .filter_map(|&target| {
-        let d = (target - cam).normalize();
-        let hit = scene.intersect(cam, d, 0.0, f32::INFINITY)?;
-        shading_point(scene, hit, -d)
-    })
-    .collect()
+    common::shading_points_towards(
+        scene,
+        Vec3::new(0.0, 1.4, 2.6),
+        &[
+            Vec3::new(0.1, 0.0, -0.4),
+            Vec3::new(-0.6, 0.45, 0.0),
+            Vec3::new(-1.2, 0.0, 0.5),
+            Vec3::new(0.9, 0.0, -1.2),
+        ],
+    )
 }
 
 fn bo_state(

@@ -2,9 +2,10 @@
 #![allow(dead_code)]
 use glam::Mat4;
 use render_core::camera::Camera;
+use render_core::estimator::ShadingPoint;
 use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext};
 use render_core::material::Material;
-use render_core::render::shading_point;
+use render_core::render::{RenderResult, RenderSettings, render, shading_point};
 use render_core::rng::SampleStream;
 use render_core::scene::{Scene, SceneBuilder};
 use render_core::stats::Counters;
@@ -197,4 +198,44 @@ pub fn mixed_scene(n_spheres: usize) -> Scene {
 
 pub fn uv(x: f32, y: f32) -> Vec2 {
     Vec2::new(x, y)
+}
+
+/// Renders `scene` through its camera (resized to `size`) with strategy `name` and `opts`.
+pub fn render_opts(
+    scene: &Scene,
+    name: &str,
+    opts: &samplers::StrategyOptions,
+    spp: u32,
+    threads: usize,
+    seed: u64,
+    size: Option<(u32, u32)>,
+) -> RenderResult {
+    let strategy = samplers::create(name, scene, opts).unwrap();
+    let mut camera = scene.camera(None).unwrap();
+    if let Some((w, h)) = size {
+        camera.width = w;
+        camera.height = h;
+    }
+    let settings = RenderSettings {
+        width: camera.width,
+        height: camera.height,
+        spp: Some(spp),
+        seed,
+        time_budget: None,
+        threads: Some(threads),
+        camera,
+    };
+    render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
+}
+
+/// The shading points where rays from `cam` towards each of `targets` first hit the scene.
+pub fn shading_points_towards(scene: &Scene, cam: Vec3, targets: &[Vec3]) -> Vec<ShadingPoint> {
+    targets
+        .iter()
+        .filter_map(|&target| {
+            let d = (target - cam).normalize();
+            let hit = scene.intersect(cam, d, 0.0, f32::INFINITY)?;
+            shading_point(scene, hit, -d)
+        })
+        .collect()
 }
