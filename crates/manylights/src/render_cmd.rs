@@ -71,7 +71,8 @@ pub struct MethodArgs {
     /// BRDF-oriented cut: split a node whose cap integral of the glossy lobe exceeds δ.
     #[arg(long, default_value_t = StrategyOptions::default().delta)]
     pub delta: f32,
-    /// Most BRDF-aware samples beyond the forced two (N = floor(N_max·UB)).
+    /// Most BRDF-aware samples beyond the forced two (N = floor(N_max·UB)); with the default
+    /// efficient N_max, its value for the first two passes.
     #[arg(long, default_value_t = StrategyOptions::default().n_max)]
     pub n_max: u32,
     /// Weight of a BRDF-sampling hit in P(BO) = n_nohit / (n_nohit + λ·n_hit).
@@ -97,6 +98,10 @@ pub struct MethodArgs {
     /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo).
     #[arg(long)]
     pub weighted_ub: bool,
+    /// Keep N_max constant (the paper's heuristic 1) instead of choosing it after each pass by
+    /// variance × cost from the samples so far (--reproduce implies it).
+    #[arg(long)]
+    pub fixed_n_max: bool,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -125,6 +130,7 @@ impl MethodArgs {
             adaptive_total: !self.no_adaptive_total,
             adaptive_split: !self.no_adaptive_split,
             weighted_ub: self.weighted_ub,
+            efficient_total: !self.fixed_n_max,
         }
     }
 }

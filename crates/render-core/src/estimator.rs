@@ -9,7 +9,7 @@ use glam::Vec3;
 /// Most per-pixel diagnostic channels a strategy can write.
 pub const MAX_AUX: usize = 4;
 /// Floats of per-pixel memory a strategy may keep across passes of the same pixel.
-pub const PIXEL_MEMORY: usize = 4;
+pub const PIXEL_MEMORY: usize = 10;
 
 /// A camera-ray hit on a reflecting surface, ready for direct lighting.
 #[derive(Clone, Copy, Debug)]
@@ -82,4 +82,9 @@ pub trait DirectLighting: Send + Sync {
         rng: &mut SampleStream,
         ctx: &mut SampleContext,
     ) -> Vec3;
+    /// Called once before a render's first sample: forget what an earlier render taught.
+    fn begin_render(&self) {}
+    /// Called after each complete pass with every pixel's memory, in pixel order (so what the
+    /// strategy learns is the same for any thread count); the next pass sees what it keeps.
+    fn end_pass(&self, _pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {}
 }

@@ -337,6 +337,7 @@ pub fn render(
         cpu_start,
         threads,
     });
+    strategy.begin_render();
     let job = PassJob {
         scene,
         strategy,
@@ -403,6 +404,7 @@ pub fn render(
             break;
         }
         spp_done += 1;
+        strategy.end_pass(&mut accum.iter().map(|p| &p.memory));
         progress(passes, spp_done);
     }
     let samples = |i: usize| (spp_done + (i < partial_pixels) as u32) as f64;

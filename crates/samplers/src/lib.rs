@@ -57,6 +57,10 @@ pub struct StrategyOptions {
     /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo), so that N follows the
     /// lobe's actual strength (off by default: see README, "weighted UB").
     pub weighted_ub: bool,
+    /// Heuristic 1's N_max chosen after each pass, from the render's samples so far, by
+    /// variance × cost ([`brdf_oriented::allocation::EfficiencyTally`]); off (and always under
+    /// `reproduce`): the constant `n_max`, as the paper.
+    pub efficient_total: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
 }
@@ -118,6 +122,7 @@ impl Default for StrategyOptions {
             pivot_sphere: false,
             adaptive_total: true,
             weighted_ub: false,
+            efficient_total: true,
             adaptive_split: true,
         }
     }
@@ -316,6 +321,7 @@ fn mis3(
         pivot_sphere: opts.pivot_sphere,
         adaptive_total: opts.adaptive_total,
         weighted_ub: opts.weighted_ub,
+        efficient_total: opts.efficient_total && !opts.reproduce,
         adaptive_split: opts.adaptive_split,
     };
     Ok(match opts.brdf_integral {
@@ -328,13 +334,7 @@ fn mis3(
             } else {
                 Sptd::default()
             };
-            Box::new(Mis3 {
-                name: name.into(),
-                mode,
-                ls,
-                integral,
-                config,
-            })
+            Box::new(Mis3::new(name.into(), mode, ls, integral, config))
         }
         BrdfIntegral::Ltc => {
             use brdf_integrals::CapIntegral;
@@ -349,13 +349,7 @@ fn mis3(
                     "--brdf-integral ltc: the LTC table integrates to 0".into(),
                 ));
             }
-            Box::new(Mis3 {
-                name: name.into(),
-                mode,
-                ls,
-                integral,
-                config,
-            })
+            Box::new(Mis3::new(name.into(), mode, ls, integral, config))
         }
     })
 }

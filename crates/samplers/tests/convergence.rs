@@ -142,11 +142,34 @@ fn image_is_identical_for_any_thread_count() {
     let c = render_with(&scene, "power+bsdf", 4, 2, 8);
     assert!(a.pixels != c.pixels, "another seed gives another image");
     // The strategies with per-thread scratch (cuts, memoised importances) too.
-    for name in ["tree-split+bsdf", "mis3-adaptive"] {
-        let a = render_with(&scene, name, 2, 1, 7);
-        let b = render_with(&scene, name, 2, 2, 7);
+    // mis3-adaptive at 4 spp: its N_max chosen after passes 2 and 3 acts on passes 3 and 4.
+    for (name, spp) in [("tree-split+bsdf", 2), ("mis3-adaptive", 4)] {
+        let a = render_with(&scene, name, spp, 1, 7);
+        let b = render_with(&scene, name, spp, 2, 7);
         assert_bit_identical(&a, &b, name);
     }
+}
+
+/// A strategy that learns between passes (mis3-adaptive's N_max) forgets it between renders:
+/// the same object renders the same image twice.
+#[test]
+fn a_strategy_object_renders_the_same_image_twice() {
+    let scene = common::mixed_scene(10);
+    let strategy = create("mis3-adaptive", &scene, &StrategyOptions::default()).unwrap();
+    let mut camera = scene.camera(None).unwrap();
+    (camera.width, camera.height) = (24, 16);
+    let settings = RenderSettings {
+        width: 24,
+        height: 16,
+        spp: Some(4),
+        seed: 3,
+        time_budget: None,
+        threads: Some(2),
+        camera,
+    };
+    let a = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
+    let b = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
+    assert_bit_identical(&a, &b, "mis3-adaptive rendered twice");
 }
 
 /// The authors' Cornell box read from their own pbrt-v3 files renders like our glTF of it

@@ -15,16 +15,115 @@
 //! BRDF sample changes the probability of the next choice and the final counts weight all
 //! samples (slightly biased).
 
+use render_core::estimator::PIXEL_MEMORY;
+
 /// Slots of the pixel memory used by the tallies.
 pub const SLOT_HITS: usize = 0;
 pub const SLOT_MISSES: usize = 1;
+/// Slots of the efficiency tally ([`EfficiencyTally`]).
+const SLOT_SAMPLES: usize = 2;
+const SLOT_SUM: usize = 3;
+const SLOT_SUM_SQ: usize = 4;
+const SLOT_WITHIN: usize = 5;
+const SLOT_UNIT: usize = 6;
+const SLOT_UB: usize = 7;
+const SLOT_GLOSSY: usize = 8;
+const SLOT_REST: usize = 9;
+
+/// The N_max values [`EfficiencyTally::best_n_max`] chooses from (about √2 apart).
+pub const N_MAX_CANDIDATES: [f32; 16] = [
+    0.0, 1.0, 2.0, 3.0, 5.0, 7.0, 10.0, 14.0, 20.0, 28.0, 40.0, 56.0, 80.0, 113.0, 160.0, 226.0,
+];
+
+/// What a render's samples so far say about the worth of BRDF-aware samples, for choosing
+/// heuristic 1's N_max by variance × cost (`--efficient-n`). Each pixel keeps, in its pixel
+/// memory (sample order, so deterministic for any thread count):
+///
+/// * the luminance y of each sample's estimate (its variance across the pixel's samples);
+/// * at glossy points, W, the variance the K BRDF-aware samples added (from the spread of
+///   their own terms), W·K, and UB;
+/// * the cost of the rest of the sample in units of one BRDF-aware sample.
+///
+/// The model: a pixel's variance is V_rest + S/K (V_rest: LS, the camera sample, diffuse
+/// points; S/K: the BRDF-aware part) with K = 2 + N_max·UB, and a pass costs
+/// Σ (c_rest + K). After each pass [`EfficiencyTally::best_n_max`] picks the N_max that
+/// minimises (Σ relMSE weight × variance) × (Σ cost): the error reached in a given time.
+pub struct EfficiencyTally;
+
+impl EfficiencyTally {
+    /// Records one sample: `y` the luminance of its estimate, `rest_cost` the cost of all but
+    /// its BRDF-aware samples, and at a glossy point `(W, K, UB)`.
+    pub fn record(memory: &mut [f32], y: f32, rest_cost: f32, glossy: Option<(f32, u32, f32)>) {
+        if !y.is_finite() {
+            return;
+        }
+        let (within, k, ub) = glossy.unwrap_or((0.0, 0, 0.0));
+        if !within.is_finite() {
+            return;
+        }
+        memory[SLOT_SAMPLES] += 1.0;
+        memory[SLOT_SUM] += y;
+        memory[SLOT_SUM_SQ] += y * y;
+        memory[SLOT_REST] += rest_cost;
+        if glossy.is_some() {
+            memory[SLOT_WITHIN] += within;
+            memory[SLOT_UNIT] += within * k as f32;
+            memory[SLOT_UB] += ub;
+            memory[SLOT_GLOSSY] += 1.0;
+        }
+    }
+
+    /// The candidate N_max with the least predicted error × cost, from every pixel with two
+    /// samples or more; `None` before any has.
+    pub fn best_n_max<'a>(memories: impl Iterator<Item = &'a [f32; PIXEL_MEMORY]>) -> Option<f32> {
+        // Per pixel i: weight w (relMSE's 1/(mean² + 0.01)), V_rest, S, UB and glossy share.
+        let (mut rest_var, mut total_var, mut pixels) = (0.0f64, 0.0f64, 0usize);
+        let mut error_at = [0.0f64; N_MAX_CANDIDATES.len()];
+        let mut cost_at = [0.0f64; N_MAX_CANDIDATES.len()];
+        for m in memories {
+            let n = m[SLOT_SAMPLES] as f64;
+            if n < 2.0 {
+                continue;
+            }
+            pixels += 1;
+            let mean = m[SLOT_SUM] as f64 / n;
+            let total = ((m[SLOT_SUM_SQ] as f64 - n * mean * mean) / (n - 1.0)).max(0.0);
+            let w = 1.0 / (mean * mean + 0.01);
+            rest_var += w * (total - m[SLOT_WITHIN] as f64 / n);
+            total_var += w * total;
+            let glossy = m[SLOT_GLOSSY] as f64 / n;
+            let unit = m[SLOT_UNIT] as f64 / n;
+            let ub = if m[SLOT_GLOSSY] > 0.0 {
+                (m[SLOT_UB] / m[SLOT_GLOSSY]) as f64
+            } else {
+                0.0
+            };
+            let rest_cost = m[SLOT_REST] as f64 / n;
+            for (j, &n_max) in N_MAX_CANDIDATES.iter().enumerate() {
+                let k = 2.0 + (n_max as f64) * ub;
+                error_at[j] += w * unit / k;
+                // A diffuse point takes one BRDF sample, a glossy one K.
+                cost_at[j] += rest_cost + (1.0 - glossy) + glossy * k;
+            }
+        }
+        if pixels == 0 {
+            return None;
+        }
+        // A few samples can put the total below the BRDF-aware part alone.
+        let rest_var = rest_var.max(0.1 * total_var);
+        let score = |j: usize| (rest_var + error_at[j]) * cost_at[j];
+        (0..N_MAX_CANDIDATES.len())
+            .min_by(|&a, &b| score(a).total_cmp(&score(b)))
+            .map(|j| N_MAX_CANDIDATES[j])
+    }
+}
 
 /// Heuristic 1: BRDF-aware samples beyond the forced two. With `adaptive` off, N_max/2.
-pub fn total_brdf_aware(upper_bound: f32, n_max: u32, adaptive: bool) -> u32 {
+pub fn total_brdf_aware(upper_bound: f32, n_max: f32, adaptive: bool) -> u32 {
     if adaptive {
-        ((n_max as f32) * upper_bound.clamp(0.0, 1.0)).floor() as u32
+        (n_max * upper_bound.clamp(0.0, 1.0)).floor() as u32
     } else {
-        n_max / 2
+        (n_max as u32) / 2
     }
 }
 
@@ -76,10 +175,10 @@ mod tests {
 
     #[test]
     fn heuristics() {
-        assert_eq!(total_brdf_aware(0.999, 50, true), 49);
-        assert_eq!(total_brdf_aware(2.0, 50, true), 50);
-        assert_eq!(total_brdf_aware(0.0, 50, true), 0);
-        assert_eq!(total_brdf_aware(0.0, 50, false), 25);
+        assert_eq!(total_brdf_aware(0.999, 50.0, true), 49);
+        assert_eq!(total_brdf_aware(2.0, 50.0, true), 50);
+        assert_eq!(total_brdf_aware(0.0, 50.0, true), 0);
+        assert_eq!(total_brdf_aware(0.0, 50.0, false), 25);
         assert_eq!(probability_bo(0.0, 0.0, 10.0), 0.5);
         assert!((probability_bo(1.0, 3.0, 10.0) - 4.0 / 15.0).abs() < 1e-6);
         assert_eq!(fixed_counts(10, 0.26), (4, 8));
@@ -88,5 +187,33 @@ mod tests {
         c.record(true);
         c.record(false);
         assert!((c.p_bo() - 2.0 / 13.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn best_n_max_follows_the_variance_split() {
+        let mut pixels = vec![[0.0f32; PIXEL_MEMORY]; 4];
+        assert_eq!(EfficiencyTally::best_n_max(pixels.iter()), None);
+        // Samples y = 1 and 3 (variance 2), with UB 1 and a rest costing 10 BRDF-aware samples.
+        let tally = |within: f32, k: u32| {
+            let mut m = [0.0f32; PIXEL_MEMORY];
+            EfficiencyTally::record(&mut m, 1.0, 10.0, Some((within, k, 1.0)));
+            EfficiencyTally::record(&mut m, 3.0, 10.0, Some((within, k, 1.0)));
+            m
+        };
+        // All the variance from 12 BRDF-aware samples: more of them pay (V_rest floored at
+        // a tenth: K* = sqrt(10 · 24 / 0.2) ≈ 35, N_max ≈ 33).
+        pixels.fill(tally(2.0, 12));
+        assert_eq!(EfficiencyTally::best_n_max(pixels.iter()), Some(28.0));
+        // None of it: the forced two are enough.
+        pixels.fill(tally(0.0, 12));
+        assert_eq!(EfficiencyTally::best_n_max(pixels.iter()), Some(0.0));
+        // Half of it from 12 samples: K* = sqrt(10 · 12 / 1) ≈ 11, N_max ≈ 9.
+        pixels.fill(tally(1.0, 12));
+        assert_eq!(EfficiencyTally::best_n_max(pixels.iter()), Some(10.0));
+        // Non-finite values are not recorded.
+        let mut m = [0.0f32; PIXEL_MEMORY];
+        EfficiencyTally::record(&mut m, f32::NAN, 1.0, None);
+        EfficiencyTally::record(&mut m, 1.0, 1.0, Some((f32::INFINITY, 2, 1.0)));
+        assert_eq!(m[SLOT_SAMPLES], 0.0);
     }
 }

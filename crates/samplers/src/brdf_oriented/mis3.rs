@@ -1,7 +1,8 @@
 //! The strategies of Liu, Xu & Yan 2019: BO alone, and three-technique MIS (tree-splitting light
 //! sampling LS + BRDF-oriented light sampling BO + BRDF sampling) with equal or adaptive counts.
 use super::allocation::{
-    InSampleCounters, SLOT_HITS, SLOT_MISSES, fixed_counts, probability_bo, total_brdf_aware,
+    EfficiencyTally, InSampleCounters, SLOT_HITS, SLOT_MISSES, fixed_counts, probability_bo,
+    total_brdf_aware,
 };
 use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
@@ -15,9 +16,12 @@ use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
 use brdf_integrals::CapIntegral;
 use render_core::Vec3;
-use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
+use render_core::colour::luminance;
+use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 pub const TECHNIQUE_LS: usize = 0;
 pub const TECHNIQUE_BO: usize = 1;
@@ -41,6 +45,11 @@ pub struct Mis3<C: CapIntegral> {
     pub ls: TreeSelection,
     pub integral: C,
     pub config: BoConfig,
+    /// Heuristic 1's N_max for the next pass (f32 bits): `config.n_max`, or with
+    /// `efficient_total` what [`EfficiencyTally::best_n_max`] chose after the last pass.
+    pub n_max_now: AtomicU32,
+    /// The N_max chosen after each pass (`efficient_total`), for the render's JSON.
+    pub n_max_chosen: Mutex<Vec<f32>>,
 }
 
 /// Per-thread buffers of one shading point: the LS picks and the samples taken.
@@ -88,6 +97,29 @@ where
 }
 
 impl<C: CapIntegral> Mis3<C> {
+    pub fn new(
+        name: String,
+        mode: Mis3Mode,
+        ls: TreeSelection,
+        integral: C,
+        config: BoConfig,
+    ) -> Self {
+        let n_max_now = AtomicU32::new((config.n_max as f32).to_bits());
+        Mis3 {
+            name,
+            mode,
+            ls,
+            integral,
+            config,
+            n_max_now,
+            n_max_chosen: Mutex::new(Vec::new()),
+        }
+    }
+
+    fn n_max_now(&self) -> f32 {
+        f32::from_bits(self.n_max_now.load(Ordering::Relaxed))
+    }
+
     /// P(BO) of the default allocation, fixed before drawing from the hit/miss tallies of the
     /// pixel's earlier samples (heuristic 2), or 1/2 with the heuristic off.
     fn planned_p_bo(&self, ctx: &SampleContext) -> f32 {
@@ -112,7 +144,14 @@ where
     }
 
     fn parameters(&self) -> serde_json::Value {
-        serde_json::to_value(&self.config).unwrap_or(serde_json::Value::Null)
+        let mut v = serde_json::to_value(&self.config).unwrap_or(serde_json::Value::Null);
+        if self.config.efficient_total
+            && let Some(map) = v.as_object_mut()
+        {
+            let chosen = self.n_max_chosen.lock().unwrap_or_else(|e| e.into_inner());
+            map.insert("n_max_after_each_pass".into(), serde_json::json!(*chosen));
+        }
+        v
     }
 
     fn techniques(&self) -> Vec<&'static str> {
@@ -126,6 +165,29 @@ where
         match self.mode {
             Mis3Mode::BoOnly => vec![],
             _ => vec!["n_brdf_aware", "bo_share"],
+        }
+    }
+
+    fn begin_render(&self) {
+        self.n_max_now
+            .store((self.config.n_max as f32).to_bits(), Ordering::Relaxed);
+        self.n_max_chosen
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .clear();
+    }
+
+    fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+        if self.config.efficient_total
+            && self.config.adaptive_total
+            && self.mode == Mis3Mode::Adaptive
+            && let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory)
+        {
+            self.n_max_now.store(n_max.to_bits(), Ordering::Relaxed);
+            self.n_max_chosen
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .push(n_max);
         }
     }
 
@@ -305,7 +367,12 @@ where
                 } else {
                     b.cut().upper_bound()
                 };
-                let n = total_brdf_aware(ub, self.config.n_max, self.config.adaptive_total);
+                let n_max = if self.config.efficient_total && self.config.adaptive_total {
+                    self.n_max_now()
+                } else {
+                    self.config.n_max as f32
+                };
+                let n = total_brdf_aware(ub, n_max, self.config.adaptive_total);
                 if self.config.reproduce {
                     // The authors' in-sample loop (biased: the outcomes pick the counts), with
                     // their one random number rescaled at every step.
@@ -362,6 +429,8 @@ where
 
         let counts = [1.0f32, n_bo as f32, n_brdf as f32];
         let mut l = Vec3::ZERO;
+        // Per BRDF-aware technique: Σz and Σz² of the luminance z of each sample's term.
+        let mut moments = [[0.0f32; 2]; 3];
         for t in taken.iter() {
             let techniques = [
                 (counts[0], t.p[0]),
@@ -378,8 +447,39 @@ where
             );
             let np = counts[t.tech] * t.p[t.tech];
             if np > 0.0 && w > 0.0 {
-                l += t.f * (w / np);
+                let term = t.f * (w / np);
+                l += term;
+                let z = luminance(term);
+                moments[t.tech][0] += z;
+                moments[t.tech][1] += z * z;
             }
+        }
+        if self.config.efficient_total
+            && self.config.adaptive_total
+            && self.mode == Mis3Mode::Adaptive
+        {
+            // In units of one BRDF-aware sample (a ray, a descent, the other techniques'
+            // densities), the rest costs about two for the camera ray and shading, one per LS
+            // cluster and a quarter per BO cluster (measured: README, "efficient N").
+            let ls_clusters = self.ls.clusters(&ls_state) as f32;
+            let bo_clusters = bo.as_ref().map_or(0, |b| b.cut().cut.len()) as f32;
+            let rest_cost = 2.0 + ls_clusters + 0.25 * bo_clusters;
+            let glossy = bo.as_ref().map(|b| {
+                // The variance the BRDF-aware samples added: n_t times the spread of one term
+                // of technique t (its samples without contribution count as zeros).
+                let mut within = 0.0;
+                for (t, n_t) in [(TECHNIQUE_BO, n_bo), (TECHNIQUE_BSDF, n_brdf)] {
+                    let [sum, sum_sq] = moments[t];
+                    let var = if n_t >= 2 {
+                        ((sum_sq - sum * sum / n_t as f32) / (n_t - 1) as f32).max(0.0)
+                    } else {
+                        sum_sq
+                    };
+                    within += n_t as f32 * var;
+                }
+                (within, n_bo + n_brdf, b.cut().upper_bound())
+            });
+            EfficiencyTally::record(&mut ctx.pixel_memory[..], luminance(l), rest_cost, glossy);
         }
         l
     }

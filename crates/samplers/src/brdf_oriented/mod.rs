@@ -72,6 +72,8 @@ pub struct BoConfig {
     pub adaptive_total: bool,
     /// Heuristic 1's UB times the glossy lobe's weight (Ks·F at θo).
     pub weighted_ub: bool,
+    /// Heuristic 1's N_max chosen after each pass by variance × cost (off: `n_max` throughout).
+    pub efficient_total: bool,
     /// Heuristic 2 (P(BO) from hit/miss counts); off: P = 1/2.
     pub adaptive_split: bool,
 }
