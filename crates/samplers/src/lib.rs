@@ -61,6 +61,10 @@ pub struct StrategyOptions {
     /// variance × cost ([`brdf_oriented::allocation::EfficiencyTally`]); off (and always under
     /// `reproduce`): the constant `n_max`, as the paper.
     pub efficient_total: bool,
+    /// In `mis3-*`, the LS technique at glossy points (where BO runs) keeps the E&K cut, as the
+    /// paper does (and `reproduce`); off (our default): one descent from the root there, the
+    /// cut stays at diffuse points.
+    pub split_ls_at_glossy: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
 }
@@ -123,6 +127,7 @@ impl Default for StrategyOptions {
             adaptive_total: true,
             weighted_ub: false,
             efficient_total: true,
+            split_ls_at_glossy: false,
             adaptive_split: true,
         }
     }
@@ -322,6 +327,7 @@ fn mis3(
         adaptive_total: opts.adaptive_total,
         weighted_ub: opts.weighted_ub,
         efficient_total: opts.efficient_total && !opts.reproduce,
+        single_ls_at_glossy: !opts.split_ls_at_glossy && !opts.reproduce,
         adaptive_split: opts.adaptive_split,
     };
     Ok(match opts.brdf_integral {

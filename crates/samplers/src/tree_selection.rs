@@ -113,14 +113,20 @@ impl TreeState {
     }
 }
 
-impl LightSelection for TreeSelection {
-    type State = TreeState;
+impl TreeSelection {
+    /// [`LightSelection::prepare`] with the adaptive cut held to at most `max_size` clusters.
+    pub fn prepare_capped(&self, sp: &ShadingPoint, max_size: usize) -> TreeState {
+        self.prepare_impl(sp, Some(max_size))
+    }
 
-    fn prepare(&self, _: &Scene, sp: &ShadingPoint) -> TreeState {
+    fn prepare_impl(&self, sp: &ShadingPoint, cap: Option<usize>) -> TreeState {
         let mut scratch = Pooled::<TreeScratch>::take();
         let (x, n) = (sp.point(), sp.bsdf.ng);
         let split = match (&self.tree, self.mode) {
-            (Some(t), TreeMode::Split(params)) => {
+            (Some(t), TreeMode::Split(mut params)) => {
+                if let Some(cap) = cap {
+                    params.max_size = params.max_size.min(cap);
+                }
                 let TreeScratch { cut, queue, .. } = &mut *scratch;
                 t.adaptive_cut_into(cut, queue, x, n, &params);
                 true
@@ -133,6 +139,14 @@ impl LightSelection for TreeSelection {
             x,
             n,
         }
+    }
+}
+
+impl LightSelection for TreeSelection {
+    type State = TreeState;
+
+    fn prepare(&self, _: &Scene, sp: &ShadingPoint) -> TreeState {
+        self.prepare_impl(sp, None)
     }
 
     fn clusters(&self, state: &TreeState) -> usize {

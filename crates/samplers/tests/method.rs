@@ -66,6 +66,10 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         efficient_total: false,
         ..d.clone()
     };
+    let split_ls = StrategyOptions {
+        split_ls_at_glossy: true,
+        ..d.clone()
+    };
     for (name, opts, label) in [
         ("mis3-adaptive", &ltc, "mis3-adaptive --brdf-integral ltc"),
         ("mis3-equal", &d, "mis3-equal"),
@@ -74,6 +78,11 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         ("mis3-adaptive", &no_h, "mis3-adaptive without heuristics"),
         ("mis3-adaptive", &weighted_ub, "mis3-adaptive --weighted-ub"),
         ("mis3-adaptive", &fixed_n_max, "mis3-adaptive --fixed-n-max"),
+        (
+            "mis3-adaptive",
+            &split_ls,
+            "mis3-adaptive --split-ls-at-glossy",
+        ),
     ] {
         let r = render_opts(scene, name, opts, spp, 2, size);
         let failures = compare(&reference, &r, 2, 3.0);

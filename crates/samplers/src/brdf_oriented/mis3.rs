@@ -229,7 +229,14 @@ where
         } else {
             self.bo_state(sp)
         };
-        let ls_state = self.ls.prepare(scene, sp);
+        // At a glossy point BO and BRDF sampling cover the lobe and LS is the defensive
+        // technique: by default one descent from the root, not the E&K cut's one light per
+        // cluster (README, "one LS descent at glossy points").
+        let ls_state = if bo.is_some() && self.config.single_ls_at_glossy {
+            self.ls.prepare_capped(sp, 1)
+        } else {
+            self.ls.prepare(scene, sp)
+        };
 
         // Densities of the three techniques at a light point (solid angle; delta lights use
         // the discrete selection probabilities and no BRDF density).

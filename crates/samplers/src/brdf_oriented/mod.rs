@@ -74,6 +74,8 @@ pub struct BoConfig {
     pub weighted_ub: bool,
     /// Heuristic 1's N_max chosen after each pass by variance × cost (off: `n_max` throughout).
     pub efficient_total: bool,
+    /// LS at glossy points (where BO runs) is one descent from the root instead of the E&K cut.
+    pub single_ls_at_glossy: bool,
     /// Heuristic 2 (P(BO) from hit/miss counts); off: P = 1/2.
     pub adaptive_split: bool,
 }
