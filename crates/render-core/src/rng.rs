@@ -29,10 +29,17 @@ impl SampleStream {
     /// A uniform number in [0, 1).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
+        // 24 high bits -> exactly representable, strictly below 1.
+        (self.next_u64() >> 40) as f32 * (1.0 / 16_777_216.0)
+    }
+
+    /// 64 uniform bits (one dimension), for draws that need more resolution than an f32's 24
+    /// bits (e.g. a bin among many and a decision inside it).
+    #[inline]
+    pub fn next_u64(&mut self) -> u64 {
         let bits = mix64(self.key ^ (self.dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
         self.dim += 1;
-        // 24 high bits -> exactly representable, strictly below 1.
-        (bits >> 40) as f32 * (1.0 / 16_777_216.0)
+        bits
     }
 
     #[inline]

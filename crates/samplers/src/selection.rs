@@ -78,7 +78,7 @@ impl LightSelection for PowerSelection {
     fn prepare(&self, _: &Scene, _: &ShadingPoint) {}
     fn pick(&self, _: &(), _: &ShadingPoint, rng: &mut SampleStream, picks: &mut Vec<(u32, f32)>) {
         if let Some(t) = &self.table {
-            let (i, p) = t.sample(rng.next_f32());
+            let (i, p) = t.sample(rng.next_u64());
             picks.push((i as u32, p));
         }
     }
