@@ -95,10 +95,9 @@ pub struct MethodArgs {
     /// Turn off heuristic 2 (P(BO) from hits and misses); P(BO) = 1/2 instead.
     #[arg(long)]
     pub no_adaptive_split: bool,
-    /// Heuristic 1 with the paper's UB instead of UB times the glossy lobe's weight (Ks·F at
-    /// θo), our default (--reproduce implies it).
+    /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo).
     #[arg(long)]
-    pub unweighted_ub: bool,
+    pub weighted_ub: bool,
     /// Keep N_max constant (the paper's heuristic 1) instead of choosing it after each pass by
     /// variance × cost from the samples so far (--reproduce implies it).
     #[arg(long)]
@@ -134,7 +133,7 @@ impl MethodArgs {
             pivot_sphere: self.pivot_sphere,
             adaptive_total: !self.no_adaptive_total,
             adaptive_split: !self.no_adaptive_split,
-            weighted_ub: !self.unweighted_ub,
+            weighted_ub: self.weighted_ub,
             efficient_total: !self.fixed_n_max,
             split_ls_at_glossy: self.split_ls_at_glossy,
         }

@@ -55,8 +55,7 @@ pub struct StrategyOptions {
     /// Heuristic 1: N = floor(N_max·UB); off: N = N_max/2.
     pub adaptive_total: bool,
     /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo), so that N follows the
-    /// lobe's actual strength (our default; off, and always under `reproduce`: the paper's
-    /// unweighted UB; see README, "weighted UB").
+    /// lobe's actual strength (off by default: see README, "weighted UB").
     pub weighted_ub: bool,
     /// Heuristic 1's N_max chosen after each pass, from the render's samples so far, by
     /// variance × cost ([`brdf_oriented::allocation::EfficiencyTally`]); off (and always under
@@ -126,7 +125,7 @@ impl Default for StrategyOptions {
             reproduce: false,
             pivot_sphere: false,
             adaptive_total: true,
-            weighted_ub: true,
+            weighted_ub: false,
             efficient_total: true,
             split_ls_at_glossy: false,
             adaptive_split: true,
@@ -326,7 +325,7 @@ fn mis3(
         reproduce: opts.reproduce,
         pivot_sphere: opts.pivot_sphere,
         adaptive_total: opts.adaptive_total,
-        weighted_ub: opts.weighted_ub && !opts.reproduce,
+        weighted_ub: opts.weighted_ub,
         efficient_total: opts.efficient_total && !opts.reproduce,
         single_ls_at_glossy: !opts.split_ls_at_glossy && !opts.reproduce,
         adaptive_split: opts.adaptive_split,

@@ -58,8 +58,8 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         brdf_integral: samplers::brdf_oriented::BrdfIntegral::Ltc,
         ..d.clone()
     };
-    let unweighted_ub = StrategyOptions {
-        weighted_ub: false,
+    let weighted_ub = StrategyOptions {
+        weighted_ub: true,
         ..d.clone()
     };
     let fixed_n_max = StrategyOptions {
@@ -76,11 +76,7 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         ("mis3-adaptive", &d, "mis3-adaptive"),
         ("mis3-adaptive", &pivot, "mis3-adaptive --pivot-sphere"),
         ("mis3-adaptive", &no_h, "mis3-adaptive without heuristics"),
-        (
-            "mis3-adaptive",
-            &unweighted_ub,
-            "mis3-adaptive --unweighted-ub",
-        ),
+        ("mis3-adaptive", &weighted_ub, "mis3-adaptive --weighted-ub"),
         ("mis3-adaptive", &fixed_n_max, "mis3-adaptive --fixed-n-max"),
         (
             "mis3-adaptive",

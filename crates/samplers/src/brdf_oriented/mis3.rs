@@ -116,20 +116,6 @@ impl<C: CapIntegral> Mis3<C> {
         }
     }
 
-    /// Heuristic 1's UB: by default times the glossy lobe's weight (Ks·F at θo), so that N
-    /// follows the lobe's actual strength, as the fidelity issue asks (README, "weighted UB");
-    /// the paper's unweighted UB with `--unweighted-ub` and `reproduce`.
-    fn heuristic_ub<L>(&self, b: &BoState<L>) -> f32
-    where
-        L: brdf_integrals::LobeIntegral + LobeDensity,
-    {
-        if self.config.weighted_ub {
-            b.cut().upper_bound() * b.rec.ks.min(1.0)
-        } else {
-            b.cut().upper_bound()
-        }
-    }
-
     fn n_max_now(&self) -> f32 {
         f32::from_bits(self.n_max_now.load(Ordering::Relaxed))
     }
@@ -381,7 +367,13 @@ where
                 (1, 1, 0)
             }
             (Some(b), _) => {
-                let ub = self.heuristic_ub(b);
+                // Heuristic 1's UB, optionally times the glossy lobe's weight (Ks·F), as the
+                // fidelity issue asks; off by default until it wins at equal time.
+                let ub = if self.config.weighted_ub {
+                    b.cut().upper_bound() * b.rec.ks.min(1.0)
+                } else {
+                    b.cut().upper_bound()
+                };
                 let n_max = if self.config.efficient_total && self.config.adaptive_total {
                     self.n_max_now()
                 } else {
@@ -492,7 +484,7 @@ where
                     };
                     within += n_t as f32 * var;
                 }
-                (within, n_bo + n_brdf, self.heuristic_ub(b))
+                (within, n_bo + n_brdf, b.cut().upper_bound())
             });
             EfficiencyTally::record(&mut ctx.pixel_memory[..], luminance(l), rest_cost, glossy);
         }
