@@ -376,6 +376,18 @@ fn mis3_flags_and_false_colour_aux() {
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("adaptive.json")).unwrap()).unwrap();
     assert_eq!(meta["strategy_parameters"]["n_max"], 20);
+    // Our defaults: N_max per pass (logged from pass 1 at --n-max) and one LS descent at glossy
+    // points; --reproduce keeps the paper's constant N_max and E&K cut.
+    let params = &meta["strategy_parameters"];
+    assert_eq!(params["n_max_by_pass"][0], serde_json::json!([1, 20.0]));
+    assert_eq!(params["efficient_total"], true);
+    assert_eq!(params["single_ls_at_glossy"], true);
+    let repro: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("repro.json")).unwrap()).unwrap();
+    let params = &repro["strategy_parameters"];
+    assert!(params.get("n_max_by_pass").is_none());
+    assert_eq!(params["efficient_total"], false);
+    assert_eq!(params["single_ls_at_glossy"], false);
     // τ: as given; else ours (0.35), or the authors' 0.85 under --reproduce, so that changing
     // our default never moves the reproduced baseline.
     for (name, tau) in [("adaptive", 0.8), ("noh", 0.35), ("repro", 0.85)] {

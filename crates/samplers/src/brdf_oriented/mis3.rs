@@ -48,8 +48,16 @@ pub struct Mis3<C: CapIntegral> {
     /// Heuristic 1's N_max for the next pass (f32 bits): `config.n_max`, or with
     /// `efficient_total` what [`EfficiencyTally::best_n_max`] chose after the last pass.
     pub n_max_now: AtomicU32,
-    /// The N_max chosen after each pass (`efficient_total`), for the render's JSON.
-    pub n_max_chosen: Mutex<Vec<f32>>,
+    /// The N_max of each pass (`efficient_total`), for the render's JSON.
+    pub n_max_log: Mutex<NMaxLog>,
+}
+
+/// Passes completed and the N_max in force from each change on: `(first pass, N_max)`, the
+/// first pass counted from 1 (a render of thousands of passes logs a few entries).
+#[derive(Default)]
+pub struct NMaxLog {
+    passes: u32,
+    changes: Vec<(u32, f32)>,
 }
 
 /// Per-thread buffers of one shading point: the LS picks and the samples taken.
@@ -112,7 +120,7 @@ impl<C: CapIntegral> Mis3<C> {
             integral,
             config,
             n_max_now,
-            n_max_chosen: Mutex::new(Vec::new()),
+            n_max_log: Mutex::new(NMaxLog::default()),
         }
     }
 
@@ -148,8 +156,8 @@ where
         if self.config.efficient_total
             && let Some(map) = v.as_object_mut()
         {
-            let chosen = self.n_max_chosen.lock().unwrap_or_else(|e| e.into_inner());
-            map.insert("n_max_after_each_pass".into(), serde_json::json!(*chosen));
+            let log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
+            map.insert("n_max_by_pass".into(), serde_json::json!(log.changes));
         }
         v
     }
@@ -171,23 +179,27 @@ where
     fn begin_render(&self) {
         self.n_max_now
             .store((self.config.n_max as f32).to_bits(), Ordering::Relaxed);
-        self.n_max_chosen
-            .lock()
-            .unwrap_or_else(|e| e.into_inner())
-            .clear();
+        let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
+        log.passes = 0;
+        log.changes.clear();
+        log.changes.push((1, self.config.n_max as f32));
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
-        if self.config.efficient_total
+        if !(self.config.efficient_total
             && self.config.adaptive_total
-            && self.mode == Mis3Mode::Adaptive
-            && let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory)
+            && self.mode == Mis3Mode::Adaptive)
         {
+            return;
+        }
+        let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
+        log.passes += 1;
+        if let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory) {
             self.n_max_now.store(n_max.to_bits(), Ordering::Relaxed);
-            self.n_max_chosen
-                .lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .push(n_max);
+            if log.changes.last().map(|c| c.1) != Some(n_max) {
+                let next = log.passes + 1;
+                log.changes.push((next, n_max));
+            }
         }
     }
 
