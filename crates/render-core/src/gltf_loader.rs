@@ -903,23 +903,6 @@ mod tests {
         }
     }
 
-    fn base64(data: &[u8]) -> String {
-        const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-        let mut out = String::new();
-        for c in data.chunks(3) {
-            let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
-            let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
-            for k in 0..4 {
-                if k <= c.len() {
-                    out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-                } else {
-                    out.push('=');
-                }
-            }
-        }
-        out
-    }
-
     /// Little-endian bytes of f32s.
     fn f32_bytes(v: &[f32]) -> Vec<u8> {
         v.iter().flat_map(|x| x.to_le_bytes()).collect()
@@ -935,7 +918,7 @@ mod tests {
     /// Writes `doc` as a .gltf whose buffer 0 holds `bin` as a base64 data URI.
     fn write_gltf(name: &str, mut doc: Value, bin: &[u8]) -> PathBuf {
         if !bin.is_empty() {
-            doc["buffers"] = json!([{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(bin)) }]);
+            doc["buffers"] = json!([{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}", base64::encode(bin)) }]);
         }
         let path = temp_path(name);
         std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();

@@ -118,7 +118,11 @@ pub fn encode(gltf: &GltfSeed, kind: Kind) -> Vec<u8> {
             if let Some(b) = doc.pointer_mut("/buffers/0").and_then(Value::as_object_mut) {
                 b.insert(
                     "uri".into(),
-                    format!("data:application/octet-stream;base64,{}", base64(&gltf.bin)).into(),
+                    format!(
+                        "data:application/octet-stream;base64,{}",
+                        base64::encode(&gltf.bin)
+                    )
+                    .into(),
                 );
             }
             serde_json::to_vec(&doc).unwrap_or_default()
@@ -164,23 +168,6 @@ fn parse_glb(b: &[u8]) -> Option<GltfSeed> {
         .as_array()
         .is_some_and(|bs| bs.iter().any(|x| x.get("uri").is_some()));
     (!external).then_some(GltfSeed { doc, bin })
-}
-
-pub fn base64(data: &[u8]) -> String {
-    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-    let mut out = String::with_capacity(data.len().div_ceil(3) * 4);
-    for c in data.chunks(3) {
-        let b = [c[0], *c.get(1).unwrap_or(&0), *c.get(2).unwrap_or(&0)];
-        let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
-        for k in 0..4 {
-            if k <= c.len() {
-                out.push(A[(n >> (18 - 6 * k) & 63) as usize] as char);
-            } else {
-                out.push('=');
-            }
-        }
-    }
-    out
 }
 
 fn f32_bytes(v: &[f32]) -> Vec<u8> {
