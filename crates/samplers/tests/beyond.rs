@@ -17,17 +17,10 @@ use samplers::tree_selection::{PowerUnits, TreeMode, TreeSelection};
 
 /// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
 fn shading_points(scene: &Scene) -> Vec<ShadingPoint> {
-    common::shading_points_towards(
-        scene,
-        Vec3::new(0.0, 1.4, 2.6),
-        &[
-            Vec3::new(0.1, 0.0, -0.4),
-            Vec3::new(-0.6, 0.45, 0.0),
-            Vec3::new(-1.2, 0.0, 0.5),
-            Vec3::new(0.9, 0.0, -1.2),
-            Vec3::new(0.6, 0.3, -0.2),
-        ],
-    )
+    // The method tests' points and one more on the metal panel.
+    let mut targets = common::MIXED_TARGETS.to_vec();
+    targets.push(Vec3::new(0.6, 0.3, -0.2));
+    common::shading_points_towards(scene, common::MIXED_CAMERA, &targets)
 }
 
 /// Chi-square of `draw` (a light index or `None`) against `pmf` over the lights, the missing

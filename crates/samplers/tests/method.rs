@@ -187,16 +187,7 @@ fn selection_counters_are_recorded() {
 
 /// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
 fn shading_points(scene: &Scene) -> Vec<ShadingPoint> {
-    common::shading_points_towards(
-        scene,
-        Vec3::new(0.0, 1.4, 2.6),
-        &[
-            Vec3::new(0.1, 0.0, -0.4),
-            Vec3::new(-0.6, 0.45, 0.0),
-            Vec3::new(-1.2, 0.0, 0.5),
-            Vec3::new(0.9, 0.0, -1.2),
-        ],
-    )
+    common::shading_points_towards(scene, common::MIXED_CAMERA, &common::MIXED_TARGETS)
 }
 
 fn bo_state(

@@ -124,6 +124,12 @@ impl<C: CapIntegral> Mis3<C> {
         }
     }
 
+    /// Whether heuristic 1's N_max is learnt between passes (`efficient_total`; never under
+    /// `reproduce`, which `create` turns it off for).
+    fn learns_n_max(&self) -> bool {
+        self.config.efficient_total && self.config.adaptive_total && self.mode == Mis3Mode::Adaptive
+    }
+
     fn n_max_now(&self) -> f32 {
         f32::from_bits(self.n_max_now.load(Ordering::Relaxed))
     }
@@ -186,10 +192,7 @@ where
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
-        if !(self.config.efficient_total
-            && self.config.adaptive_total
-            && self.mode == Mis3Mode::Adaptive)
-        {
+        if !self.learns_n_max() {
             return;
         }
         let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
@@ -386,7 +389,7 @@ where
                 } else {
                     b.cut().upper_bound()
                 };
-                let n_max = if self.config.efficient_total && self.config.adaptive_total {
+                let n_max = if self.learns_n_max() {
                     self.n_max_now()
                 } else {
                     self.config.n_max as f32
@@ -448,6 +451,7 @@ where
 
         let counts = [1.0f32, n_bo as f32, n_brdf as f32];
         let mut l = Vec3::ZERO;
+        let learns = self.learns_n_max();
         // Per BRDF-aware technique: Σz and Σz² of the luminance z of each sample's term.
         let mut moments = [[0.0f32; 2]; 3];
         for t in taken.iter() {
@@ -468,18 +472,18 @@ where
             if np > 0.0 && w > 0.0 {
                 let term = t.f * (w / np);
                 l += term;
-                let z = luminance(term);
-                moments[t.tech][0] += z;
-                moments[t.tech][1] += z * z;
+                if learns {
+                    let z = luminance(term);
+                    moments[t.tech][0] += z;
+                    moments[t.tech][1] += z * z;
+                }
             }
         }
-        if self.config.efficient_total
-            && self.config.adaptive_total
-            && self.mode == Mis3Mode::Adaptive
-        {
+        if learns {
             // In units of one BRDF-aware sample (a ray, a descent, the other techniques'
             // densities), the rest costs about two for the camera ray and shading, one per LS
-            // cluster and a quarter per BO cluster (measured: README, "efficient N").
+            // cluster and a quarter per BO cluster (measured: ARCHITECTURE.md, "N_max chosen
+            // by variance × cost").
             let ls_clusters = self.ls.clusters(&ls_state) as f32;
             let bo_clusters = bo.as_ref().map_or(0, |b| b.cut().cut.len()) as f32;
             let rest_cost = 2.0 + ls_clusters + 0.25 * bo_clusters;

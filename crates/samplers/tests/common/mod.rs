@@ -228,6 +228,16 @@ pub fn render_opts(
     render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
 }
 
+/// Camera of [`mixed_scene`]'s shading-point tests, and targets on its glossy floor, metal panel
+/// and diffuse panel.
+pub const MIXED_CAMERA: Vec3 = Vec3::new(0.0, 1.4, 2.6);
+pub const MIXED_TARGETS: [Vec3; 4] = [
+    Vec3::new(0.1, 0.0, -0.4),
+    Vec3::new(-0.6, 0.45, 0.0),
+    Vec3::new(-1.2, 0.0, 0.5),
+    Vec3::new(0.9, 0.0, -1.2),
+];
+
 /// The shading points where rays from `cam` towards each of `targets` first hit the scene.
 pub fn shading_points_towards(scene: &Scene, cam: Vec3, targets: &[Vec3]) -> Vec<ShadingPoint> {
     targets
