@@ -54,8 +54,11 @@ enum Command {
         image: std::path::PathBuf,
         reference: std::path::PathBuf,
         /// Light mask written by `render --aux` (non-black = the camera sees a light there).
+        /// Given more than once, a pixel is unlit only if it is in every mask: pass the
+        /// reference's mask and the image's own, as the experiment harness does, so that a
+        /// light the image's camera rays hit but the reference's never did is left out too.
         #[arg(long)]
-        mask: Option<std::path::PathBuf>,
+        mask: Vec<std::path::PathBuf>,
         /// Print JSON.
         #[arg(long)]
         json: bool,
@@ -82,7 +85,7 @@ fn main() -> ExitCode {
             mask,
             json,
             worst,
-        } => compare(&image, &reference, mask.as_deref(), json, worst),
+        } => compare(&image, &reference, &mask, json, worst),
         Command::CapIntegral { method } => cap_integral(&method),
         Command::Strategies => {
             for s in samplers::strategies() {
@@ -177,7 +180,7 @@ fn info(spec: &str, json: bool) -> anyhow::Result<()> {
 fn compare(
     image: &std::path::Path,
     reference: &std::path::Path,
-    mask: Option<&std::path::Path>,
+    masks: &[std::path::PathBuf],
     json: bool,
     worst: usize,
 ) -> anyhow::Result<()> {
@@ -192,10 +195,14 @@ fn compare(
         );
     }
     let all = error_metrics(&x, &r, None);
-    let unlit_mask = match mask {
-        Some(m) => Some(render_core::output::read_mask_png(m, w, h).map_err(anyhow::Error::msg)?),
-        None => None,
-    };
+    let mut unlit_mask: Option<Vec<bool>> = None;
+    for m in masks {
+        let unlit = render_core::output::read_mask_png(m, w, h).map_err(anyhow::Error::msg)?;
+        unlit_mask = Some(match unlit_mask {
+            Some(acc) => acc.iter().zip(&unlit).map(|(a, b)| *a && *b).collect(),
+            None => unlit,
+        });
+    }
     let unlit = unlit_mask
         .as_deref()
         .map(|m| error_metrics(&x, &r, Some(m)));

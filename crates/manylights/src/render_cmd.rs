@@ -102,6 +102,10 @@ pub struct MethodArgs {
     /// variance × cost from the samples so far (--reproduce implies it).
     #[arg(long)]
     pub fixed_n_max: bool,
+    /// mis3-adaptive: draw a shading point's BRDF-aware samples independently instead of as
+    /// one stratified set per technique.
+    #[arg(long)]
+    pub independent_samples: bool,
     /// mis3 strategies: keep the E&K cut (one light per cluster) for LS at glossy points, as the
     /// paper, instead of one descent there (--reproduce implies it).
     #[arg(long)]
@@ -135,6 +139,7 @@ impl MethodArgs {
             adaptive_split: !self.no_adaptive_split,
             weighted_ub: self.weighted_ub,
             efficient_total: !self.fixed_n_max,
+            stratified: !self.independent_samples,
             split_ls_at_glossy: self.split_ls_at_glossy,
         }
     }

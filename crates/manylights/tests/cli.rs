@@ -279,7 +279,11 @@ fn compare_reports_error_against_a_reference() {
             .status
             .success()
     );
-    assert!(render_to(&dir, "b", &["--seed", "2"]).status.success());
+    assert!(
+        render_to(&dir, "b", &["--seed", "2", "--aux"])
+            .status
+            .success()
+    );
     let (a, b, mask) = (dir.join("a.exr"), dir.join("b.exr"), dir.join("a.mask.png"));
     let o = manylights(&[
         "compare",
@@ -323,6 +327,26 @@ fn compare_reports_error_against_a_reference() {
     ]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["all"]["rel_mse"].as_f64().unwrap(), 0.0);
+    // Several masks: a pixel is unlit only if every mask says so.
+    let unlit_with = |masks: &[&std::path::Path]| {
+        let mut args = vec![
+            "compare",
+            a.to_str().unwrap(),
+            b.to_str().unwrap(),
+            "--json",
+        ];
+        for m in masks {
+            args.extend(["--mask", m.to_str().unwrap()]);
+        }
+        let o = manylights(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["unlit"]["pixels"].as_u64().unwrap()
+    };
+    let own_b = dir.join("b.mask.png");
+    let both = unlit_with(&[&mask, &own_b]);
+    assert_eq!(unlit_with(&[&mask, &mask]), unlit);
+    assert!(both <= unlit && both <= unlit_with(&[&own_b]));
 }
 
 #[test]
@@ -376,18 +400,21 @@ fn mis3_flags_and_false_colour_aux() {
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("adaptive.json")).unwrap()).unwrap();
     assert_eq!(meta["strategy_parameters"]["n_max"], 20);
-    // Our defaults: N_max per pass (logged from pass 1 at --n-max) and one LS descent at glossy
-    // points; --reproduce keeps the paper's constant N_max and E&K cut.
+    // Our defaults: N_max per pass (logged from pass 1 at --n-max), one LS descent at glossy
+    // points and stratified BRDF-aware samples; --reproduce keeps the paper's constant N_max,
+    // E&K cut and independent samples.
     let params = &meta["strategy_parameters"];
     assert_eq!(params["n_max_by_pass"][0], serde_json::json!([1, 20.0]));
     assert_eq!(params["efficient_total"], true);
     assert_eq!(params["single_ls_at_glossy"], true);
+    assert_eq!(params["stratified"], true);
     let repro: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("repro.json")).unwrap()).unwrap();
     let params = &repro["strategy_parameters"];
     assert!(params.get("n_max_by_pass").is_none());
     assert_eq!(params["efficient_total"], false);
     assert_eq!(params["single_ls_at_glossy"], false);
+    assert_eq!(params["stratified"], false);
     // τ: as given; else ours (0.35), or the authors' 0.85 under --reproduce, so that changing
     // our default never moves the reproduced baseline.
     for (name, tau) in [("adaptive", 0.8), ("noh", 0.35), ("repro", 0.85)] {

@@ -37,6 +37,17 @@ pub fn sample_bsdf(
 ) -> Option<BsdfLightHit> {
     let u_lobe = rng.next_f32();
     let u = rng.next_2d();
+    sample_bsdf_at(scene, sp, u_lobe, u, counters)
+}
+
+/// [`sample_bsdf`] with its three numbers given (lobe choice, direction).
+pub fn sample_bsdf_at(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    u_lobe: f32,
+    u: render_core::Vec2,
+    counters: &mut Counters,
+) -> Option<BsdfLightHit> {
     let s = sp.bsdf.sample(sp.wo, u_lobe, u)?;
     counters.bsdf_rays += 1;
     let origin = sp.origin_towards(s.wi);

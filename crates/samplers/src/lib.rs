@@ -15,6 +15,7 @@ pub mod light_strategy;
 pub mod memo;
 pub mod mis;
 pub mod oracle;
+pub mod point_sets;
 pub mod ris;
 pub mod scratch;
 pub mod selection;
@@ -61,6 +62,9 @@ pub struct StrategyOptions {
     /// variance × cost ([`brdf_oriented::allocation::EfficiencyTally`]); off (and always under
     /// `reproduce`): the constant `n_max`, as the paper.
     pub efficient_total: bool,
+    /// In `mis3-adaptive` (fixed counts), the BRDF-aware samples of a shading point as one
+    /// stratified set per technique (each sample still uniform on its own); off: independent.
+    pub stratified: bool,
     /// In `mis3-*`, the LS technique at glossy points (where BO runs) keeps the E&K cut, as the
     /// paper does (and `reproduce`); off (our default): one descent from the root there, the
     /// cut stays at diffuse points.
@@ -127,6 +131,7 @@ impl Default for StrategyOptions {
             adaptive_total: true,
             weighted_ub: false,
             efficient_total: true,
+            stratified: true,
             split_ls_at_glossy: false,
             adaptive_split: true,
         }
@@ -327,6 +332,7 @@ fn mis3(
         adaptive_total: opts.adaptive_total,
         weighted_ub: opts.weighted_ub,
         efficient_total: opts.efficient_total && !opts.reproduce,
+        stratified: opts.stratified && !opts.reproduce,
         single_ls_at_glossy: !opts.split_ls_at_glossy && !opts.reproduce,
         adaptive_split: opts.adaptive_split,
     };

@@ -70,6 +70,10 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         split_ls_at_glossy: true,
         ..d.clone()
     };
+    let independent = StrategyOptions {
+        stratified: false,
+        ..d.clone()
+    };
     for (name, opts, label) in [
         ("mis3-adaptive", &ltc, "mis3-adaptive --brdf-integral ltc"),
         ("mis3-equal", &d, "mis3-equal"),
@@ -78,6 +82,11 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         ("mis3-adaptive", &no_h, "mis3-adaptive without heuristics"),
         ("mis3-adaptive", &weighted_ub, "mis3-adaptive --weighted-ub"),
         ("mis3-adaptive", &fixed_n_max, "mis3-adaptive --fixed-n-max"),
+        (
+            "mis3-adaptive",
+            &independent,
+            "mis3-adaptive --independent-samples",
+        ),
         (
             "mis3-adaptive",
             &split_ls,

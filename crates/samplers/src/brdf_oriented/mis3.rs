@@ -8,18 +8,19 @@ use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
 use super::technique::BoState;
 use super::{BoConfig, LobePivot};
-use crate::bsdf_sampling::sample_bsdf;
+use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
 use crate::light_strategy::sample_pick;
 use crate::mis::power_heuristic;
+use crate::point_sets::{lattice_1d, r3_point};
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
 use brdf_integrals::CapIntegral;
-use render_core::Vec3;
 use render_core::colour::luminance;
 use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
+use render_core::{Vec2, Vec3};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -313,72 +314,86 @@ where
         }
 
         // One BO sample.
-        let bo_sample =
-            |taken: &mut Vec<Taken>, rng: &mut SampleStream, ctx: &mut SampleContext| {
-                let Some(b) = bo.as_ref() else { return };
-                ctx.counters.technique_samples[TECHNIQUE_BO] += 1;
-                let Some((light, p_sel)) = b.select(tree, rng, fresh) else {
-                    return;
-                };
-                let Some(s) = b.sample_point(&scene.lights[light], rng) else {
-                    return;
-                };
-                let p_bo = p_sel * s.pdf;
-                if !(p_bo > 0.0) {
-                    return;
-                }
-                let f = sp.shade(scene, &s, ctx.counters);
-                if f == Vec3::ZERO {
-                    return;
-                }
-                let mut p = densities(light, s.point, s.normal, s.wi, s.is_delta, TECHNIQUE_BO);
-                debug_assert!(
-                    (p[TECHNIQUE_BO] - p_bo).abs() <= 1e-3 * p_bo,
-                    "BO pdf at sampling {p_bo} vs replay {}",
-                    p[TECHNIQUE_BO]
-                );
-                p[TECHNIQUE_BO] = p_bo;
-                taken.push(Taken {
-                    tech: TECHNIQUE_BO,
-                    f,
-                    p,
-                });
+        // `u_cluster`: the cluster choice's number when the caller stratifies them.
+        let bo_sample = |taken: &mut Vec<Taken>,
+                         rng: &mut SampleStream,
+                         ctx: &mut SampleContext,
+                         u_cluster: Option<f32>| {
+            let Some(b) = bo.as_ref() else { return };
+            ctx.counters.technique_samples[TECHNIQUE_BO] += 1;
+            let picked = match u_cluster {
+                Some(u) => b.select_with(tree, u, rng, fresh),
+                None => b.select(tree, rng, fresh),
             };
+            let Some((light, p_sel)) = picked else {
+                return;
+            };
+            let Some(s) = b.sample_point(&scene.lights[light], rng) else {
+                return;
+            };
+            let p_bo = p_sel * s.pdf;
+            if !(p_bo > 0.0) {
+                return;
+            }
+            let f = sp.shade(scene, &s, ctx.counters);
+            if f == Vec3::ZERO {
+                return;
+            }
+            let mut p = densities(light, s.point, s.normal, s.wi, s.is_delta, TECHNIQUE_BO);
+            debug_assert!(
+                (p[TECHNIQUE_BO] - p_bo).abs() <= 1e-3 * p_bo,
+                "BO pdf at sampling {p_bo} vs replay {}",
+                p[TECHNIQUE_BO]
+            );
+            p[TECHNIQUE_BO] = p_bo;
+            taken.push(Taken {
+                tech: TECHNIQUE_BO,
+                f,
+                p,
+            });
+        };
         // One BRDF sample; returns whether it reached an emitter.
-        let bsdf_sample =
-            |taken: &mut Vec<Taken>, rng: &mut SampleStream, ctx: &mut SampleContext| {
-                ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
-                let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters) else {
-                    return false;
-                };
-                if !b.found_light() {
-                    return false;
-                }
-                let mut p = densities(
-                    b.light as usize,
-                    b.point,
-                    b.normal,
-                    b.wi,
-                    false,
-                    TECHNIQUE_BSDF,
-                );
-                p[TECHNIQUE_BSDF] = b.pdf;
-                taken.push(Taken {
-                    tech: TECHNIQUE_BSDF,
-                    f: b.f_cos * b.radiance,
-                    p,
-                });
-                true
+        // `u`: the lobe choice's and the direction's numbers when the caller stratifies them.
+        let bsdf_sample = |taken: &mut Vec<Taken>,
+                           rng: &mut SampleStream,
+                           ctx: &mut SampleContext,
+                           u: Option<(f32, Vec2)>| {
+            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
+            let drawn = match u {
+                Some((u_lobe, u_dir)) => sample_bsdf_at(scene, sp, u_lobe, u_dir, ctx.counters),
+                None => sample_bsdf(scene, sp, rng, ctx.counters),
             };
+            let Some(b) = drawn else {
+                return false;
+            };
+            if !b.found_light() {
+                return false;
+            }
+            let mut p = densities(
+                b.light as usize,
+                b.point,
+                b.normal,
+                b.wi,
+                false,
+                TECHNIQUE_BSDF,
+            );
+            p[TECHNIQUE_BSDF] = b.pdf;
+            taken.push(Taken {
+                tech: TECHNIQUE_BSDF,
+                f: b.f_cos * b.radiance,
+                p,
+            });
+            true
+        };
 
         let (n_bo, n_brdf, n_extra) = match (&bo, self.mode) {
             (None, _) => {
-                bsdf_sample(taken, rng, ctx);
+                bsdf_sample(taken, rng, ctx, None);
                 (0, 1, 0)
             }
             (Some(_), Mis3Mode::Equal) => {
-                bo_sample(taken, rng, ctx);
-                bsdf_sample(taken, rng, ctx);
+                bo_sample(taken, rng, ctx, None);
+                bsdf_sample(taken, rng, ctx, None);
                 (1, 1, 0)
             }
             (Some(b), _) => {
@@ -399,8 +414,8 @@ where
                     // The authors' in-sample loop (biased: the outcomes pick the counts), with
                     // their one random number rescaled at every step.
                     let mut c = InSampleCounters::new(self.config.lambda);
-                    bo_sample(taken, rng, ctx);
-                    c.record(bsdf_sample(taken, rng, ctx));
+                    bo_sample(taken, rng, ctx, None);
+                    c.record(bsdf_sample(taken, rng, ctx, None));
                     let (mut n_bo, mut n_brdf) = (1, 1);
                     let mut u = rng.next_f32();
                     for _ in 0..n {
@@ -410,11 +425,11 @@ where
                             0.5
                         };
                         if u < p {
-                            bo_sample(taken, rng, ctx);
+                            bo_sample(taken, rng, ctx, None);
                             n_bo += 1;
                             u /= p;
                         } else {
-                            c.record(bsdf_sample(taken, rng, ctx));
+                            c.record(bsdf_sample(taken, rng, ctx, None));
                             n_brdf += 1;
                             u = (u - p) / (1.0 - p);
                         }
@@ -423,12 +438,21 @@ where
                 } else {
                     // Counts fixed before drawing, from earlier samples of this pixel.
                     let (n_bo, n_brdf) = fixed_counts(n, self.planned_p_bo(ctx));
-                    for _ in 0..n_bo {
-                        bo_sample(taken, rng, ctx);
+                    // Stratified by default: one random shift per technique and shading point
+                    // (see `stratified`); each sample stays uniform on its own, so the fixed-count
+                    // MIS estimator stays unbiased.
+                    let strata = self
+                        .config
+                        .stratified
+                        .then(|| (rng.next_f32(), rng.next_f32(), rng.next_2d()));
+                    for i in 0..n_bo {
+                        let u = strata.map(|(shift, ..)| lattice_1d(shift, i, n_bo));
+                        bo_sample(taken, rng, ctx, u);
                     }
                     let mut hits = 0u32;
-                    for _ in 0..n_brdf {
-                        hits += bsdf_sample(taken, rng, ctx) as u32;
+                    for i in 0..n_brdf {
+                        let u = strata.map(|(_, lobe, dir)| r3_point(lobe, dir, i));
+                        hits += bsdf_sample(taken, rng, ctx, u) as u32;
                     }
                     ctx.pixel_memory[SLOT_HITS] += hits as f32;
                     ctx.pixel_memory[SLOT_MISSES] += (n_brdf - hits) as f32;
@@ -489,7 +513,9 @@ where
             let rest_cost = 2.0 + ls_clusters + 0.25 * bo_clusters;
             let glossy = bo.as_ref().map(|b| {
                 // The variance the BRDF-aware samples added: n_t times the spread of one term
-                // of technique t (its samples without contribution count as zeros).
+                // of technique t (its samples without contribution count as zeros). With
+                // stratified samples this independent-sample formula overstates their variance
+                // (a neighbouring-strata estimator for BO measured the same at equal time).
                 let mut within = 0.0;
                 for (t, n_t) in [(TECHNIQUE_BO, n_bo), (TECHNIQUE_BSDF, n_brdf)] {
                     let [sum, sum_sq] = moments[t];

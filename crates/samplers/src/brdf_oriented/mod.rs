@@ -74,6 +74,9 @@ pub struct BoConfig {
     pub weighted_ub: bool,
     /// Heuristic 1's N_max chosen after each pass by variance × cost (off: `n_max` throughout).
     pub efficient_total: bool,
+    /// With fixed counts: a shading point's BO cluster choices stratified (a shifted 1D
+    /// lattice) and its BRDF samples' numbers a shifted R3 point set, instead of independent.
+    pub stratified: bool,
     /// LS at glossy points (where BO runs) is one descent from the root instead of the E&K cut.
     pub single_ls_at_glossy: bool,
     /// Heuristic 2 (P(BO) from hit/miss counts); off: P = 1/2.

@@ -76,8 +76,21 @@ impl<L: LobeIntegral + LobeDensity> BoState<L> {
         rng: &mut SampleStream,
         fresh: bool,
     ) -> Option<(usize, f32)> {
+        let u = rng.next_f32();
+        self.select_with(tree, u, rng, fresh)
+    }
+
+    /// [`BoState::select`] with the cluster chosen by `u_cluster` (so that a shading point's
+    /// BO samples can share one stratified set of cluster choices).
+    pub fn select_with(
+        &self,
+        tree: &LightTree,
+        u_cluster: f32,
+        rng: &mut SampleStream,
+        fresh: bool,
+    ) -> Option<(usize, f32)> {
         let cut = self.cut();
-        let (k, p_cl, _) = cut.pick(rng.next_f32())?;
+        let (k, p_cl, _) = cut.pick(u_cluster)?;
         let start = cut.cut.nodes[k];
         let imp = |c| self.importance(tree, c);
         let (light, p) = if fresh {
