@@ -11,7 +11,7 @@ use super::{BoConfig, LobePivot};
 use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
 use crate::light_strategy::sample_pick;
 use crate::mis::power_heuristic;
-use crate::point_sets::{lattice_1d, r3_point};
+use crate::point_sets::{lattice_1d, lattice_sum_variance, r3_point};
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
@@ -66,10 +66,13 @@ pub struct NMaxLog {
 pub struct Mis3Scratch {
     taken: Vec<Taken>,
     picks: Vec<(u32, f32)>,
+    /// The luminance of each BO sample's term in stratum order (zeros included).
+    bo_terms: Vec<f32>,
 }
 crate::scratch_pool!(Mis3Scratch, |s| {
     s.taken.clear();
     s.picks.clear();
+    s.bo_terms.clear();
 });
 
 /// A sample with a non-zero unweighted contribution: technique, f·L (shadowed), and the densities
@@ -77,6 +80,8 @@ crate::scratch_pool!(Mis3Scratch, |s| {
 #[derive(Clone, Copy, Debug)]
 struct Taken {
     tech: usize,
+    /// The sample's index among its technique's samples at this shading point.
+    index: u32,
     f: Vec3,
     p: [f32; 3],
 }
@@ -280,7 +285,11 @@ where
                 [p_ls, p_bo, p_bsdf]
             };
         let mut scratch = Pooled::<Mis3Scratch>::take();
-        let Mis3Scratch { taken, picks } = &mut *scratch;
+        let Mis3Scratch {
+            taken,
+            picks,
+            bo_terms,
+        } = &mut *scratch;
 
         // LS: one light per cluster of the E&K cut (a splitting technique counts as one sample).
         self.ls.pick(&ls_state, sp, rng, picks);
@@ -308,6 +317,7 @@ where
             p[TECHNIQUE_LS] = p_ls;
             taken.push(Taken {
                 tech: TECHNIQUE_LS,
+                index: 0,
                 f,
                 p,
             });
@@ -318,6 +328,7 @@ where
         let bo_sample = |taken: &mut Vec<Taken>,
                          rng: &mut SampleStream,
                          ctx: &mut SampleContext,
+                         index: u32,
                          u_cluster: Option<f32>| {
             let Some(b) = bo.as_ref() else { return };
             ctx.counters.technique_samples[TECHNIQUE_BO] += 1;
@@ -348,6 +359,7 @@ where
             p[TECHNIQUE_BO] = p_bo;
             taken.push(Taken {
                 tech: TECHNIQUE_BO,
+                index,
                 f,
                 p,
             });
@@ -380,21 +392,22 @@ where
             p[TECHNIQUE_BSDF] = b.pdf;
             taken.push(Taken {
                 tech: TECHNIQUE_BSDF,
+                index: 0,
                 f: b.f_cos * b.radiance,
                 p,
             });
             true
         };
 
-        let (n_bo, n_brdf, n_extra) = match (&bo, self.mode) {
+        let (n_bo, n_brdf, n_extra, stratified) = match (&bo, self.mode) {
             (None, _) => {
                 bsdf_sample(taken, rng, ctx, None);
-                (0, 1, 0)
+                (0, 1, 0, false)
             }
             (Some(_), Mis3Mode::Equal) => {
-                bo_sample(taken, rng, ctx, None);
+                bo_sample(taken, rng, ctx, 0, None);
                 bsdf_sample(taken, rng, ctx, None);
-                (1, 1, 0)
+                (1, 1, 0, false)
             }
             (Some(b), _) => {
                 // Heuristic 1's UB, optionally times the glossy lobe's weight (Ks·F), as the
@@ -414,7 +427,7 @@ where
                     // The authors' in-sample loop (biased: the outcomes pick the counts), with
                     // their one random number rescaled at every step.
                     let mut c = InSampleCounters::new(self.config.lambda);
-                    bo_sample(taken, rng, ctx, None);
+                    bo_sample(taken, rng, ctx, 0, None);
                     c.record(bsdf_sample(taken, rng, ctx, None));
                     let (mut n_bo, mut n_brdf) = (1, 1);
                     let mut u = rng.next_f32();
@@ -425,7 +438,7 @@ where
                             0.5
                         };
                         if u < p {
-                            bo_sample(taken, rng, ctx, None);
+                            bo_sample(taken, rng, ctx, 0, None);
                             n_bo += 1;
                             u /= p;
                         } else {
@@ -434,7 +447,7 @@ where
                             u = (u - p) / (1.0 - p);
                         }
                     }
-                    (n_bo, n_brdf, n)
+                    (n_bo, n_brdf, n, false)
                 } else {
                     // Counts fixed before drawing, from earlier samples of this pixel.
                     let (n_bo, n_brdf) = fixed_counts(n, self.planned_p_bo(ctx));
@@ -447,7 +460,7 @@ where
                         .then(|| (rng.next_f32(), rng.next_f32(), rng.next_2d()));
                     for i in 0..n_bo {
                         let u = strata.map(|(shift, ..)| lattice_1d(shift, i, n_bo));
-                        bo_sample(taken, rng, ctx, u);
+                        bo_sample(taken, rng, ctx, i, u);
                     }
                     let mut hits = 0u32;
                     for i in 0..n_brdf {
@@ -456,7 +469,7 @@ where
                     }
                     ctx.pixel_memory[SLOT_HITS] += hits as f32;
                     ctx.pixel_memory[SLOT_MISSES] += (n_brdf - hits) as f32;
-                    (n_bo, n_brdf, n)
+                    (n_bo, n_brdf, n, strata.is_some())
                 }
             }
         };
@@ -478,6 +491,11 @@ where
         let learns = self.learns_n_max();
         // Per BRDF-aware technique: Σz and Σz² of the luminance z of each sample's term.
         let mut moments = [[0.0f32; 2]; 3];
+        // Stratified BO terms, in stratum order, for their variance (below).
+        let stratified_bo = learns && stratified;
+        if stratified_bo {
+            bo_terms.resize(n_bo as usize, 0.0);
+        }
         for t in taken.iter() {
             let techniques = [
                 (counts[0], t.p[0]),
@@ -500,6 +518,9 @@ where
                     let z = luminance(term);
                     moments[t.tech][0] += z;
                     moments[t.tech][1] += z * z;
+                    if stratified_bo && t.tech == TECHNIQUE_BO {
+                        bo_terms[t.index as usize] = z;
+                    }
                 }
             }
         }
@@ -513,11 +534,18 @@ where
             let rest_cost = 2.0 + ls_clusters + 0.25 * bo_clusters;
             let glossy = bo.as_ref().map(|b| {
                 // The variance the BRDF-aware samples added: n_t times the spread of one term
-                // of technique t (its samples without contribution count as zeros). With
-                // stratified samples this independent-sample formula overstates their variance
-                // (a neighbouring-strata estimator for BO measured the same at equal time).
+                // of technique t (its samples without contribution count as zeros). Stratified
+                // BO samples: collapsed strata (`lattice_sum_variance`), as the spread over all
+                // strata would count the differences between them; the R3 set of BRDF samples
+                // has no such neighbours, and keeps the spread (an overestimate).
                 let mut within = 0.0;
+                if stratified_bo {
+                    within += lattice_sum_variance(bo_terms);
+                }
                 for (t, n_t) in [(TECHNIQUE_BO, n_bo), (TECHNIQUE_BSDF, n_brdf)] {
+                    if t == TECHNIQUE_BO && stratified_bo {
+                        continue;
+                    }
                     let [sum, sum_sq] = moments[t];
                     let var = if n_t >= 2 {
                         ((sum_sq - sum * sum / n_t as f32) / (n_t - 1) as f32).max(0.0)
