@@ -45,7 +45,7 @@ fn run(a: &Args) -> Result<usize, String> {
         return Err("width and height must be positive".into());
     }
     let scene =
-        render_core::load_scene(&a.scene, a.camera.as_deref()).map_err(|e| e.to_string())?;
+        scene_formats::load_scene(&a.scene, a.camera.as_deref()).map_err(|e| e.to_string())?;
     let camera = scene.camera(None).map_err(|e| e.to_string())?;
     let (w, h) = (a.width, a.height);
     let aspect = w as f32 / h as f32;

@@ -104,7 +104,7 @@ fn main() -> ExitCode {
 }
 
 fn list_scenes() {
-    for b in render_core::builtin::list_builtins() {
+    for b in scene_formats::builtin::list_builtins() {
         println!("builtin:{}\n    {}", b.name, b.description);
         for (key, default, help) in &b.keys {
             println!("    {key:<10} default {default:<10} {help}");
@@ -113,11 +113,11 @@ fn list_scenes() {
 }
 
 fn convert(spec: &str, out: &std::path::Path) -> anyhow::Result<()> {
-    let scene = render_core::load_scene(spec, None)?;
+    let scene = scene_formats::load_scene(spec, None)?;
     for w in &scene.stats.warnings {
         eprintln!("warning: {w}");
     }
-    for w in render_core::gltf_writer::write_glb(&scene, out)? {
+    for w in scene_formats::gltf_writer::write_glb(&scene, out)? {
         eprintln!("warning: {w}");
     }
     println!(
@@ -130,7 +130,7 @@ fn convert(spec: &str, out: &std::path::Path) -> anyhow::Result<()> {
 }
 
 fn info(spec: &str, json: bool) -> anyhow::Result<()> {
-    let scene = render_core::load_scene(spec, None)?;
+    let scene = scene_formats::load_scene(spec, None)?;
     let s = &scene.stats;
     if json {
         let v = serde_json::json!({ "scene": spec, "stats": s, "bounds": [scene.bounds.0.to_array(), scene.bounds.1.to_array()], "cameras": scene.cameras.iter().map(|c| &c.name).collect::<Vec<_>>() });

@@ -211,7 +211,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.png {
         check_writable(p)?;
     }
-    let scene = render_core::load_scene(&args.scene, args.camera.as_deref())?;
+    let scene = scene_formats::load_scene(&args.scene, args.camera.as_deref())?;
     if !args.quiet {
         for w in &scene.stats.warnings {
             eprintln!("warning: {w}");

@@ -4,11 +4,11 @@
 //! Refactors must leave these hashes unchanged. A change that is meant to move images (a new
 //! default, a different random-number use) regenerates the file with
 //! `GOLDEN_UPDATE=1 cargo test -p manylights --test golden_images` and says so in its commit.
-use render_core::load_scene;
 use render_core::render::{RenderResult, RenderSettings, render};
 use render_core::scene::Scene;
 use samplers::StrategyOptions;
 use samplers::brdf_oriented::BrdfIntegral;
+use scene_formats::load_scene;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
@@ -152,11 +152,17 @@ fn scenes(dir: &Path) -> Vec<(String, Scene)> {
         })
         .collect();
     let glb = dir.join("cornell.glb");
-    render_core::gltf_writer::write_glb(&out[6].1, &glb).unwrap();
-    out.push(("glb:cornell".into(), load_scene(glb.to_str().unwrap(), None).unwrap()));
+    scene_formats::gltf_writer::write_glb(&out[6].1, &glb).unwrap();
+    out.push((
+        "glb:cornell".into(),
+        load_scene(glb.to_str().unwrap(), None).unwrap(),
+    ));
     let pbrt = dir.join("room.pbrt");
     std::fs::write(&pbrt, PBRT_SCENE).unwrap();
-    out.push(("pbrt:room".into(), load_scene(pbrt.to_str().unwrap(), None).unwrap()));
+    out.push((
+        "pbrt:room".into(),
+        load_scene(pbrt.to_str().unwrap(), None).unwrap(),
+    ));
     out
 }
 

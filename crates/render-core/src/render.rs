@@ -508,6 +508,49 @@ mod tests {
         }
     }
 
+    /// A glossy floor under 64 small sphere lights on a jittered grid, seen from above at an angle.
+    fn test_scene() -> Scene {
+        use crate::camera::Camera;
+        use crate::material::Material;
+        let mut b = crate::scene::SceneBuilder::new("render-test");
+        let floor = b
+            .add_material(Material::simple("floor", Vec3::splat(0.6), 0.0, 0.3))
+            .unwrap();
+        let p = [
+            Vec3::new(-4.0, 0.0, -4.0),
+            Vec3::new(4.0, 0.0, -4.0),
+            Vec3::new(4.0, 0.0, 4.0),
+            Vec3::new(-4.0, 0.0, 4.0),
+        ];
+        b.add_mesh(
+            "floor",
+            &p,
+            None,
+            None,
+            &[0, 2, 1, 0, 3, 2],
+            glam::Mat4::IDENTITY,
+            floor,
+        )
+        .unwrap();
+        for i in 0..64u32 {
+            let (x, z) = ((i % 8) as f32 - 3.5, (i / 8) as f32 - 3.5);
+            let jitter = ((i * 37 % 11) as f32 / 11.0 - 0.5) * 0.4;
+            let centre = Vec3::new(x + jitter, 0.5 + 0.1 * (i % 5) as f32, z - jitter);
+            b.add_sphere_light(centre, 0.02, Vec3::splat(50.0 + i as f32), None)
+                .unwrap();
+        }
+        b.add_camera(Camera::look_at(
+            "top",
+            Vec3::new(0.0, 5.0, 7.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            0.7,
+            64,
+            40,
+        ));
+        b.build().unwrap()
+    }
+
     fn run(scene: &Scene, spp: Option<u32>, budget: Option<f64>, threads: usize) -> RenderResult {
         let settings = RenderSettings {
             width: 64,
@@ -526,7 +569,7 @@ mod tests {
 
     #[test]
     fn images_are_identical_for_any_thread_count() {
-        let scene = crate::builtin::load_builtin("builtin:glossy-spheres?lights=64").unwrap();
+        let scene = test_scene();
         let a = run(&scene, Some(3), None, 1);
         let b = run(&scene, Some(3), None, 3);
         assert_eq!((a.spp, a.partial_pixels, b.spp), (3, 0, 3));
@@ -540,7 +583,7 @@ mod tests {
     /// the start of a fixed-spp render, whatever the thread count.
     #[test]
     fn a_budget_ends_at_a_unit_boundary_inside_a_pass() {
-        let scene = crate::builtin::load_builtin("builtin:glossy-spheres?lights=64").unwrap();
+        let scene = test_scene();
         let full = run(&scene, Some(1), None, 2);
         let pixels = 64 * 40;
         assert!(pixels > 4 * UNIT_PIXELS, "the image needs several units");

@@ -146,6 +146,21 @@ impl Scene {
         (self.bounds.1 - self.bounds.0).length()
     }
 
+    /// Makes the camera called `name` the first one (the one [`Scene::camera`]`(None)`
+    /// returns); `None` changes nothing, an unknown name is an error.
+    pub fn select_camera(&mut self, name: Option<&str>) -> Result<(), SceneError> {
+        if let Some(name) = name {
+            let i = self
+                .cameras
+                .iter()
+                .position(|c| c.name == name)
+                .ok_or_else(|| SceneError::CameraNotFound(name.into()))?;
+            let c = self.cameras.remove(i);
+            self.cameras.insert(0, c);
+        }
+        Ok(())
+    }
+
     pub fn camera(&self, name: Option<&str>) -> Result<Camera, SceneError> {
         match name {
             Some(n) => self

@@ -58,7 +58,7 @@ fn bench_strategies(c: &mut Criterion) {
     }
     let options = StrategyOptions::default();
     for (label, spec) in scenes {
-        let scene = render_core::load_scene(&spec, None).unwrap();
+        let scene = scene_formats::load_scene(&spec, None).unwrap();
         let points = shading_points(&scene, 16);
         println!("{label}: {} shading points per iteration", points.len());
         let mut g = c.benchmark_group(label);

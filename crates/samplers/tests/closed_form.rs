@@ -138,14 +138,14 @@ fn pbrt_sphere_and_disk_lights_over_lambertian_plane() {
         std::fs::write(&path, text).unwrap();
         let mut b = SceneBuilder::new(name);
         floor(&mut b, 50.0);
-        render_core::pbrt::add_pbrt(&mut b, &path, glam::Mat4::IDENTITY).unwrap();
+        scene_formats::pbrt::add_pbrt(&mut b, &path, glam::Mat4::IDENTITY).unwrap();
         let scene = b.build().unwrap();
         let expected = if name == "sphere.pbrt" {
             assert_eq!(scene.stats.sphere_lights, 1);
             let d = glam::DVec3::from(centre).length();
             radiance * (radius / d).powi(2) * centre[2] / d
         } else {
-            let n = render_core::pbrt::shapes::SEGMENTS;
+            let n = scene_formats::pbrt::shapes::SEGMENTS;
             assert_eq!(scene.stats.triangle_lights, n);
             // the tessellated disk: a regular n-gon inscribed in the circle
             let v: Vec<[f64; 3]> = (0..n)

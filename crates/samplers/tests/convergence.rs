@@ -68,7 +68,7 @@ fn baseline_strategies_agree_on_a_mixed_scene() {
 #[test]
 fn oracle_and_ris_agree_with_power_bsdf() {
     let mixed = common::mixed_scene(40);
-    let spheres = render_core::load_scene(
+    let spheres = scene_formats::load_scene(
         "builtin:glossy-spheres?lights=64&radius=0.1&roughness=0.5",
         None,
     )
@@ -184,7 +184,8 @@ fn bisml_cornell_from_pbrt_agrees_with_its_gltf() {
         eprintln!("skipped: {} is not present", dir.display());
         return;
     }
-    let load = |p: std::path::PathBuf| render_core::load_scene(p.to_str().unwrap(), None).unwrap();
+    let load =
+        |p: std::path::PathBuf| scene_formats::load_scene(p.to_str().unwrap(), None).unwrap();
     let pbrt = load(dir.join("pbrt/scene.pbrt"));
     let gltf = load(dir.join("bisml_cornell.glb"));
     let small = |scene: &Scene, seed: u64| {

@@ -111,7 +111,7 @@ fn mis3_converges_on_the_mixed_scene() {
 
 #[test]
 fn mis3_converges_on_glossy_spheres() {
-    let scene = render_core::load_scene(
+    let scene = scene_formats::load_scene(
         "builtin:glossy-spheres?lights=64&radius=0.1&roughness=0.5",
         None,
     )
@@ -124,7 +124,7 @@ fn mis3_converges_on_glossy_spheres() {
 
 #[test]
 fn mis3_converges_on_diffuse_quads() {
-    let scene = render_core::load_scene("builtin:diffuse-quads?lights=64", None).unwrap();
+    let scene = scene_formats::load_scene("builtin:diffuse-quads?lights=64", None).unwrap();
     check_against_reference(&scene, Some((32, 24)), 128, 32);
 }
 
@@ -420,7 +420,7 @@ fn measure_reproduce_bias() {
         ("mixed(40)", common::mixed_scene(40), None),
         (
             "glossy-spheres lights=256 r=0.1 rough=0.5",
-            render_core::load_scene(
+            scene_formats::load_scene(
                 "builtin:glossy-spheres?lights=256&radius=0.1&roughness=0.5",
                 None,
             )
@@ -480,7 +480,7 @@ fn mis3_converges_on_the_other_builtins() {
         "builtin:staircase?lights=64&radius=0.05&roughness=0.5",
         "builtin:grid?lights=64&roughness=0.5",
     ] {
-        let scene = render_core::load_scene(spec, None).unwrap();
+        let scene = scene_formats::load_scene(spec, None).unwrap();
         let size = Some((24, 18));
         let reference = render_opts(&scene, "power+bsdf", &d, 1024, 1, size);
         let r = render_opts(&scene, "mis3-adaptive", &d, 96, 2, size);

@@ -1,6 +1,6 @@
 //! Deterministic fuzzing of the scene inputs. Case `k` of a run with seed `s` mutates one of
 //! the valid [`corpus`] inputs with a generator seeded by (s, k) alone, writes it into the
-//! run's directory, loads it with `render_core::load_scene` and, when it loads, renders it at
+//! run's directory, loads it with `scene_formats::load_scene` and, when it loads, renders it at
 //! 8×6 pixels and 1 spp with one of the registered strategies (in turn). A case passes when it
 //! ends in a scene or an error, and fails on:
 //!
@@ -282,7 +282,7 @@ fn load_and_render(path: &Path, case: u64) -> Result<Outcome, String> {
             Ok(())
         }
     };
-    let scene = match render_core::load_scene(&path.display().to_string(), None) {
+    let scene = match scene_formats::load_scene(&path.display().to_string(), None) {
         Ok(s) => s,
         Err(e) => {
             one_line(e.to_string())?;

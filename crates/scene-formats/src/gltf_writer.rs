@@ -1,5 +1,5 @@
 //! Writes a loaded [`Scene`] as a binary glTF (`.glb`), so that a scene read from another
-//! format (pbrt) can be inspected in any glTF viewer and loaded back by [`crate::gltf_loader`]:
+//! format (pbrt) can be inspected in any glTF viewer and loaded back by [`crate::gltf_reader`]:
 //! - triangles in world space, one primitive per material (positions, normals, uvs);
 //! - materials as metallic-roughness, emission as emissiveFactor × `KHR_materials_emissive_strength`,
 //!   `KHR_materials_specular` where the specular factor is not 1, and `extras.pbrt` where glTF
@@ -11,11 +11,11 @@
 //! - cameras (a mirrored camera cannot be said in glTF: written unmirrored, with a warning).
 //!
 //! Textures are not written (a warning names the materials that had one).
-use crate::error::SceneError;
-use crate::light::LightShape;
-use crate::material::{Material, Model};
-use crate::scene::Scene;
 use glam::{Mat3, Quat, Vec3};
+use render_core::error::SceneError;
+use render_core::light::LightShape;
+use render_core::material::{Material, Model};
+use render_core::scene::Scene;
 use serde_json::{Value, json};
 use std::f32::consts::PI;
 use std::path::Path;
@@ -267,7 +267,7 @@ pub fn write_glb(scene: &Scene, path: &Path) -> Result<Vec<String>, SceneError> 
     out.extend((bin.len() as u32).to_le_bytes());
     out.extend(b"BIN\0");
     out.extend(&bin);
-    crate::output::write_atomically(path, |tmp| {
+    render_core::output::write_atomically(path, |tmp| {
         std::fs::write(tmp, &out).map_err(|e| e.to_string())
     })
     .map_err(|e| io_err(path, e))?;

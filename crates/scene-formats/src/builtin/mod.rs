@@ -17,12 +17,12 @@ pub mod mesh;
 mod staircase;
 mod statue;
 
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::{Scene, SceneBuilder};
 use glam::Vec3;
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::{Scene, SceneBuilder};
 use std::f32::consts::PI;
 
 /// What `manylights scenes` prints about one built-in scene.
@@ -406,7 +406,7 @@ pub fn light_color(rng: &mut Pcg32) -> Vec3 {
         [1.0, 1.0, 1.0],
     ];
     let c = Vec3::from(PALETTE[(rng.random::<u32>() % PALETTE.len() as u32) as usize]);
-    c / crate::colour::luminance(c)
+    c / render_core::colour::luminance(c)
 }
 
 /// Radiance (luminance) of each of `n` sphere lights of radius `r` so that together they emit

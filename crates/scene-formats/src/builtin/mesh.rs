@@ -2,9 +2,9 @@
 //! UV spheres, cylinders, tori and tubes along curves. Every mesh has per-vertex normals and
 //! counter-clockwise winding around its outward normal (the front face), and no degenerate
 //! triangles.
-use crate::error::SceneError;
-use crate::scene::SceneBuilder;
 use glam::{Mat4, Vec2, Vec3};
+use render_core::error::SceneError;
+use render_core::scene::SceneBuilder;
 use std::f32::consts::{FRAC_PI_4, PI, TAU};
 
 #[derive(Clone, Debug, Default)]

@@ -4,11 +4,11 @@
 //! between the camera and the statue).
 use super::mesh::Mesh;
 use super::{Params, light_color, sphere_radiance, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::{Mat4, Vec3};
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 use std::f32::consts::TAU;
 
 const TOTAL_POWER: f32 = 400.0;

@@ -3,11 +3,11 @@
 //! are far from any given shading point, so a light tree clearly beats power sampling.
 use super::mesh::Mesh;
 use super::{Params, light_color, sphere_radiance, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::Vec3;
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 
 /// Total emitted power: the irradiance under the light field is about 2 (P / 2A).
 const TOTAL_POWER: f32 = 3600.0;

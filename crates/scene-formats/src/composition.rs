@@ -26,14 +26,14 @@
 //! target = [0.0, 0.8, 0.0]
 //! ```
 use crate::builtin::mesh::Mesh;
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::gltf_loader::add_gltf;
-use crate::material::Material;
-use crate::scene::{Scene, SceneBuilder};
+use crate::gltf_reader::add_gltf;
 use glam::{Mat4, Vec3};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::{Scene, SceneBuilder};
 use serde::Deserialize;
 use std::f32::consts::PI;
 use std::path::Path;
@@ -181,7 +181,7 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
         path: path.display().to_string(),
         message,
     };
-    crate::gltf_loader::regular_file(path).map_err(io)?;
+    crate::gltf_reader::regular_file(path).map_err(io)?;
     let text = std::fs::read_to_string(path).map_err(|e| io(e.to_string()))?;
     let comp: Composition = toml::from_str(&text).map_err(|e| {
         // toml's message spans several lines (location, excerpt, reason): keep it on one.
@@ -307,7 +307,7 @@ fn add_lights(b: &mut SceneBuilder, l: &LightLayout) -> Result<(), SceneError> {
     let c = Vec3::from(l.center);
     let e = Vec3::from(l.extent);
     let per_light = l.power / l.count as f32;
-    let lum = crate::colour::luminance(Vec3::from(l.color)).max(1e-6);
+    let lum = render_core::colour::luminance(Vec3::from(l.color)).max(1e-6);
     let color = Vec3::from(l.color) / lum;
     let side = (l.count as f32).sqrt().ceil() as usize;
     let quad_material = if l.shape == Shape::Quad {

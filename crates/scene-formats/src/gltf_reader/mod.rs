@@ -4,7 +4,7 @@
 //! - every triangle primitive (`TRIANGLES`, `TRIANGLE_STRIP`, `TRIANGLE_FAN`; indexed or not) of
 //!   every node of the default scene (else the first scene, else every root node), under the
 //!   node's full world transform; `POSITION`, `NORMAL` and one `TEXCOORD_n` set;
-//!   points and lines are skipped and counted in [`SceneStats`](crate::scene::SceneStats);
+//!   points and lines are skipped and counted in [`SceneStats`](render_core::scene::SceneStats);
 //! - metallic-roughness materials: baseColor factor × texture (sRGB decoded), metallic and
 //!   roughness factors × texture (linear, G = roughness, B = metallic), `KHR_materials_specular`
 //!   specularFactor (1 when absent; 0 makes the material pure Lambert), doubleSided, and
@@ -12,7 +12,7 @@
 //!   decoded). The [`SceneBuilder`] turns emissive triangles into area lights (zero-average ones
 //!   are not lights);
 //! - a material's `extras.pbrt` (its pbrt description, as `manylights convert` and the
-//!   bisml_cornell scene write it) replaces the reflection model: see [`crate::pbrt_extras`];
+//!   bisml_cornell scene write it) replaces the reflection model: see [`crate::gltf_reader::pbrt_extras`];
 //! - `KHR_lights_punctual`: see [`PunctualUnits`] below for the unit convention;
 //! - perspective cameras (`yfov`, `aspectRatio`), looking down the node's −Z with +Y up.
 //!
@@ -32,13 +32,15 @@
 //! - directional: irradiance E = `color × intensity`, direction to the light = node +Z.
 //!
 //! No photometric (lumen → watt) conversion is applied.
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::light::SpotCone;
-use crate::material::Material;
-use crate::scene::{Scene, SceneBuilder};
-use crate::texture::{Texture, srgb_to_linear};
+pub mod pbrt_extras;
+
 use glam::{Mat4, Vec2, Vec3, Vec4};
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::light::SpotCone;
+use render_core::material::Material;
+use render_core::scene::{Scene, SceneBuilder};
+use render_core::texture::{Texture, srgb_to_linear};
 use std::collections::HashMap;
 use std::f32::consts::PI;
 use std::path::Path;
@@ -124,24 +126,9 @@ pub fn load_gltf_with_report(
             format!("no triangles: all {} are degenerate", report.triangles),
         ));
     }
-    select_camera(&mut scene, camera)?;
+    scene.select_camera(camera)?;
     scene.stats.warnings.extend(report.warnings.iter().cloned());
     Ok((scene, report))
-}
-
-/// Makes the camera called `name` the scene's first one (the one `Scene::camera(None)`
-/// returns); `None` changes nothing, an unknown name is an error.
-pub fn select_camera(scene: &mut Scene, name: Option<&str>) -> Result<(), SceneError> {
-    if let Some(name) = name {
-        let i = scene
-            .cameras
-            .iter()
-            .position(|c| c.name == name)
-            .ok_or_else(|| SceneError::CameraNotFound(name.into()))?;
-        let c = scene.cameras.remove(i);
-        scene.cameras.insert(0, c);
-    }
-    Ok(())
 }
 
 fn gltf_err(path: &Path, message: impl Into<String>) -> SceneError {
@@ -551,7 +538,7 @@ impl Loader<'_> {
                     emission_texture,
                     model: Default::default(),
                 };
-                match crate::pbrt_extras::material(gltf_material, m.extras()) {
+                match crate::gltf_reader::pbrt_extras::material(gltf_material, m.extras()) {
                     Ok(mat) => mat,
                     Err((mat, warning)) => {
                         self.report.warn(warning);
@@ -892,7 +879,7 @@ fn convert_image(img: &gltf::image::Data, srgb: bool) -> Result<Texture, String>
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::light::LightShape;
+    use render_core::light::LightShape;
     use serde_json::{Value, json};
     use std::path::PathBuf;
 
@@ -910,7 +897,7 @@ mod tests {
 
     fn temp_path(name: &str) -> PathBuf {
         let dir =
-            std::env::temp_dir().join(format!("render-core-gltf-tests-{}", std::process::id()));
+            std::env::temp_dir().join(format!("scene-formats-gltf-tests-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         dir.join(name)
     }
@@ -1120,7 +1107,7 @@ mod tests {
         // The white texel decodes to linear 1; the triangle's uvs (0.25..0.75) straddle both texels.
         let m = scene.lights[1].mean_emission;
         assert!(m.x > 0.2 && m.x < 0.8, "{m}");
-        assert_eq!(scene.triangles[2].light, crate::scene::NO_LIGHT);
+        assert_eq!(scene.triangles[2].light, render_core::scene::NO_LIGHT);
     }
 
     #[test]
@@ -1291,7 +1278,7 @@ mod tests {
     /// → a warning and the glTF material.
     #[test]
     fn extras_pbrt_materials_load_as_described() {
-        use crate::material::{Model, Specular};
+        use render_core::material::{Model, Specular};
         let (mut doc, bin) = triangle_doc(TRI);
         let materials = [
             json!({ "name": "wall", "pbrMetallicRoughness": { "baseColorFactor": [0.1, 0.1, 0.1, 1] },
@@ -1341,7 +1328,7 @@ mod tests {
             (ks, m("remapped").base_color),
             (Vec3::splat(0.25), Vec3::splat(0.25))
         );
-        assert!((alpha - crate::plastic::roughness_to_alpha(0.1)).abs() < 1e-7);
+        assert!((alpha - render_core::plastic::roughness_to_alpha(0.1)).abs() < 1e-7);
 
         assert_eq!(params("no-spec").specular, Specular::None);
         assert!(matches!(params("plain").specular, Specular::Schlick { .. }));

@@ -17,9 +17,9 @@ pub mod tokenizer;
 #[cfg(test)]
 mod tests;
 
-use crate::error::SceneError;
-use crate::scene::{Scene, SceneBuilder};
 use glam::Mat4;
+use render_core::error::SceneError;
+use render_core::scene::{Scene, SceneBuilder};
 use std::path::Path;
 
 pub use parser::PbrtReport;
@@ -53,6 +53,6 @@ pub fn load_pbrt_with_report(
     }
     let mut scene = builder.build()?;
     scene.stats.warnings.extend(report.warnings.iter().cloned());
-    crate::gltf_loader::select_camera(&mut scene, camera)?;
+    scene.select_camera(camera)?;
     Ok((scene, report))
 }

@@ -1,5 +1,5 @@
 use super::*;
-use crate::light::LightShape;
+use render_core::light::LightShape;
 
 fn err(r: Result<Scene, SceneError>) -> SceneError {
     match r {
@@ -372,7 +372,7 @@ fn grid_lights_fill_rows_and_scale_their_radius() {
 /// Uniform light selection, light sampling only: enough to see that light reaches the view.
 struct UniformLights;
 
-impl crate::estimator::DirectLighting for UniformLights {
+impl render_core::estimator::DirectLighting for UniformLights {
     fn name(&self) -> String {
         "test-uniform".into()
     }
@@ -380,9 +380,9 @@ impl crate::estimator::DirectLighting for UniformLights {
     fn estimate(
         &self,
         scene: &Scene,
-        sp: &crate::estimator::ShadingPoint,
-        rng: &mut crate::rng::SampleStream,
-        ctx: &mut crate::estimator::SampleContext,
+        sp: &render_core::estimator::ShadingPoint,
+        rng: &mut render_core::rng::SampleStream,
+        ctx: &mut render_core::estimator::SampleContext,
     ) -> Vec3 {
         let n = scene.lights.len();
         let i = ((rng.next_f32() * n as f32) as usize).min(n - 1);
@@ -395,7 +395,7 @@ impl crate::estimator::DirectLighting for UniformLights {
 
 #[test]
 fn every_builtin_renders_a_lit_image() {
-    use crate::render::{RenderSettings, render};
+    use render_core::render::{RenderSettings, render};
     for info in list_builtins() {
         let scene = load_builtin(&format!("builtin:{}?lights=200", info.name)).unwrap();
         let camera = scene.camera(None).unwrap();
@@ -415,7 +415,7 @@ fn every_builtin_renders_a_lit_image() {
             .iter()
             .zip(&r.light_fraction)
             .filter(|(_, f)| **f == 0.0)
-            .map(|(p, _)| crate::colour::luminance(*p))
+            .map(|(p, _)| render_core::colour::luminance(*p))
             .collect();
         assert!(
             lit.iter().all(|v| v.is_finite() && *v >= 0.0),

@@ -3,11 +3,11 @@
 //! diffuse floor and back wall.
 use super::mesh::Mesh;
 use super::{Params, sphere_radiance, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::{Mat4, Vec3};
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 use std::f32::consts::TAU;
 
 const TOTAL_POWER: f32 = 150.0;
@@ -120,7 +120,12 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
             uniform(&mut rng, 0.7, 0.85),
             uniform(&mut rng, 0.45, 0.6),
         );
-        b.add_sphere_light(c, radius, warm / crate::colour::luminance(warm) * l, None)?;
+        b.add_sphere_light(
+            c,
+            radius,
+            warm / render_core::colour::luminance(warm) * l,
+            None,
+        )?;
     }
     b.add_camera(Camera::look_at(
         "main",

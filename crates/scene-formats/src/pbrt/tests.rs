@@ -1,12 +1,12 @@
 //! The pbrt loader against small scenes written by the tests.
 use super::*;
-use crate::light::LightShape;
-use crate::material::{Model, Specular};
 use glam::{Vec2, Vec3};
+use render_core::light::LightShape;
+use render_core::material::{Model, Specular};
 use std::path::PathBuf;
 
 fn dir(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("render-core-pbrt-{}-{test}", std::process::id()));
+    let d = std::env::temp_dir().join(format!("scene-formats-pbrt-{}-{test}", std::process::id()));
     std::fs::create_dir_all(&d).unwrap();
     d
 }
@@ -124,7 +124,7 @@ Shape "curve" "point3 P" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]
 WorldEnd
 "#;
 
-fn load_test_scene() -> (crate::scene::Scene, PbrtReport, PathBuf) {
+fn load_test_scene() -> (render_core::scene::Scene, PbrtReport, PathBuf) {
     let d = dir("every");
     write_plys(&d);
     write(
@@ -331,7 +331,7 @@ fn convert_round_trips_through_gltf() {
     let (scene, _, path) = load_test_scene();
     let glb = path.with_extension("glb");
     crate::gltf_writer::write_glb(&scene, &glb).unwrap();
-    let back = crate::gltf_loader::load_gltf(&glb, None).unwrap();
+    let back = crate::gltf_reader::load_gltf(&glb, None).unwrap();
     assert_eq!(back.triangles.len(), scene.triangles.len());
     let (a, b) = (&scene.stats, &back.stats);
     assert_eq!(
@@ -418,7 +418,7 @@ fn bisml_cornell_pbrt_loads_like_its_gltf() {
         return;
     }
     let (scene, report) = load_pbrt_with_report(&dir.join("pbrt/scene.pbrt"), None).unwrap();
-    let glb = crate::gltf_loader::load_gltf(&dir.join("bisml_cornell.glb"), None).unwrap();
+    let glb = crate::gltf_reader::load_gltf(&dir.join("bisml_cornell.glb"), None).unwrap();
     assert_eq!(scene.stats.sphere_lights, 1494);
     assert_eq!(scene.triangles.len(), glb.triangles.len());
     assert!(

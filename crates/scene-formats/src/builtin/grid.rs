@@ -4,11 +4,11 @@
 //! the default radius is 0.05 × spacing (0.005 at N = 10⁴).
 use super::mesh::Mesh;
 use super::{Params, light_color, sphere_radiance, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::Vec3;
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 
 const TOTAL_POWER: f32 = 200.0;
 const SIZE: f32 = 10.0;

@@ -3,11 +3,11 @@
 //! handrail height.
 use super::mesh::Mesh;
 use super::{Params, pick, sphere_radiance, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::Vec3;
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 
 const TOTAL_POWER: f32 = 120.0;
 const STEPS: usize = 12;
@@ -91,7 +91,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
 
     // Lamps: 60 % along the tread edges, 40 % on the walls just below the handrails.
     let l = sphere_radiance(TOTAL_POWER, n, radius);
-    let warm = Vec3::new(1.0, 0.8, 0.6) / crate::colour::luminance(Vec3::new(1.0, 0.8, 0.6));
+    let warm = Vec3::new(1.0, 0.8, 0.6) / render_core::colour::luminance(Vec3::new(1.0, 0.8, 0.6));
     for _ in 0..n {
         let c = if uniform(&mut rng, 0.0, 1.0) < 0.6 {
             let k = pick(&mut rng, STEPS);

@@ -3,11 +3,11 @@
 //! emissive panels above them.
 use super::mesh::Mesh;
 use super::{Params, area_radiance, emitter, light_color, sphere_radiance, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::{Mat4, Vec3};
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 
 /// Power of the ceiling's sphere lights together, and of the three panels together.
 const SPHERES_POWER: f32 = 2000.0;

@@ -2,11 +2,11 @@
 //! 12 × 12 region, over purely diffuse (Lambert, no specular lobe) floor, boxes and spheres.
 use super::mesh::Mesh;
 use super::{Params, area_radiance, emitter, light_color, pick, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::{Quat, Vec3};
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 use std::f32::consts::TAU;
 
 /// Total emitted power: irradiance about 2 under the quads (P / A for one-sided emitters).

@@ -6,12 +6,12 @@
 //! main radiances. The camera is theirs (eye (0, 1, 6.8), 19.5°).
 use super::mesh::Mesh;
 use super::{Params, uniform};
-use crate::camera::Camera;
-use crate::colour::luminance;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::{Mat4, Vec3};
+use render_core::camera::Camera;
+use render_core::colour::luminance;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 
 /// The authors' light count and radius: at these the radiances below are theirs.
 const REF_LIGHTS: usize = 1494;

@@ -16,7 +16,7 @@ fn shipped_compositions_load() {
             eprintln!("skipping {}: ../shared/scenes is absent", path.display());
             continue;
         }
-        let scene = render_core::load_scene(path.to_str().unwrap(), None)
+        let scene = scene_formats::load_scene(path.to_str().unwrap(), None)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
         assert!(
             scene.lights.len() >= 1000,

@@ -4,11 +4,11 @@
 //! thousands of them, and nearby triangles of one sphere face every way.
 use super::mesh::Mesh;
 use super::{Params, area_radiance, emitter, light_color, pick, uniform};
-use crate::camera::Camera;
-use crate::error::SceneError;
-use crate::material::Material;
-use crate::scene::SceneBuilder;
 use glam::Vec3;
+use render_core::camera::Camera;
+use render_core::error::SceneError;
+use render_core::material::Material;
+use render_core::scene::SceneBuilder;
 
 /// Total emitted power: irradiance of a few units on the ground under the cloud.
 const TOTAL_POWER: f32 = 400.0;
