@@ -9,9 +9,13 @@ use std::fmt;
 use std::io::{BufRead, Write};
 use std::str::FromStr;
 
+/// Which integrator [`run_batch`] uses. Parsed case-insensitively from `sptd`, `ltc` or
+/// `reference` (also `ref`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
+    /// [`Sptd::default`]: the committed SPTD table, default options.
     Sptd,
+    /// [`Ltc::default`]: the committed LTC table, default options.
     Ltc,
     /// The reference integrator with [`Reference::default`] samples (2¹⁶ per row).
     Reference,
@@ -31,12 +35,16 @@ impl FromStr for Method {
     }
 }
 
+/// Why [`run_batch`] stopped.
 #[derive(Debug)]
 pub enum BatchError {
+    /// Reading the input or writing the output failed.
     Io(std::io::Error),
     /// A malformed row; `line` is 1-based.
     Parse {
+        /// 1-based line number in the input (blank and comment lines count).
         line: usize,
+        /// What is wrong with the row, naming the field.
         message: String,
     },
 }
@@ -68,14 +76,18 @@ impl From<std::io::Error> for BatchError {
 /// One parsed row.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Row {
+    /// GGX roughness α, in (0, 1].
     pub alpha: f32,
+    /// View angle θo from the normal in radians, in [0, π/2]; ωo = (sin θo, 0, cos θo).
     pub theta_o: f32,
+    /// The cap, in the local frame, with its axis normalised.
     pub cap: Cap,
 }
 
 const FIELDS: [&str; 6] = ["alpha", "theta_o", "cap_x", "cap_y", "cap_z", "cap_cos"];
 
-/// Parses one data line (1-based `line` for messages).
+/// Parses one data line `alpha,theta_o,cap_x,cap_y,cap_z,cap_cos` (1-based `line` for
+/// messages). Checks ranges: α ∈ (0, 1], θo ∈ [0, π/2], a non-zero axis, cap_cos ∈ [−1, 1].
 pub fn parse_row(text: &str, line: usize) -> Result<Row, BatchError> {
     let err = |message: String| BatchError::Parse { line, message };
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();

@@ -10,11 +10,16 @@ use std::f64::consts::PI;
 /// `cos_theta` in [−1, 1] (negative: larger than a hemisphere).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cap {
+    /// Centre direction of the cap (unit length).
     pub axis: Vec3,
+    /// Cosine of the cap's half-angle, in [−1, 1]: 1 is a single direction, 0 a hemisphere,
+    /// −1 the whole sphere.
     pub cos_theta: f32,
 }
 
 impl Cap {
+    /// The cap around the unit vector `axis` with half-angle cosine `cos_theta` (stored as
+    /// given: neither is normalised or clamped).
     pub fn new(axis: Vec3, cos_theta: f32) -> Self {
         Self { axis, cos_theta }
     }
@@ -39,10 +44,11 @@ impl Cap {
             cos_theta: ((d2 - r2) / d2).sqrt() as f32,
         })
     }
-    /// Solid angle 2π(1 − cos θ).
+    /// Solid angle 2π(1 − cos θ), in steradians.
     pub fn solid_angle(&self) -> f32 {
         (2.0 * PI * (1.0 - self.cos_theta as f64)) as f32
     }
+    /// Whether the unit direction `w` is in the cap (boundary included).
     pub fn contains(&self, w: Vec3) -> bool {
         w.dot(self.axis) >= self.cos_theta
     }
@@ -54,12 +60,17 @@ impl Cap {
 /// `f64` cap used internally (public for the fitting tools); keeps sin θ beside cos θ.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cap64 {
+    /// Centre direction (unit length).
     pub axis: DVec3,
+    /// Cosine of the half-angle, in [−1, 1].
     pub cos: f64,
+    /// Sine of the half-angle, in [0, 1]; kept consistent with `cos` by [`Cap64::new`].
     pub sin: f64,
 }
 
 impl Cap64 {
+    /// The cap around the unit vector `axis` with half-angle cosine `cos` (clamped to
+    /// [−1, 1]); computes the matching sine. `axis` is not normalised.
     pub fn new(axis: DVec3, cos: f64) -> Self {
         let cos = cos.clamp(-1.0, 1.0);
         Self {
@@ -68,30 +79,34 @@ impl Cap64 {
             sin: (1.0 - cos * cos).max(0.0).sqrt(),
         }
     }
+    /// The same cap in `f32` (drops the sine).
     pub fn to32(self) -> Cap {
         Cap {
             axis: self.axis.as_vec3(),
             cos_theta: self.cos as f32,
         }
     }
+    /// Solid angle 2π(1 − cos θ), in steradians.
     #[inline]
     pub fn area(&self) -> f64 {
         2.0 * PI * (1.0 - self.cos)
     }
+    /// Half-angle θ in radians, in [0, π].
     #[inline]
     pub fn angle(&self) -> f64 {
         self.sin.atan2(self.cos)
     }
 }
 
-/// Area of a ∩ b, exact (spherical lens closed form).
+/// Area of a ∩ b, exact (spherical lens closed form), in steradians (0 when disjoint). The
+/// axes are renormalised in `f64` before use.
 pub fn intersection_area_exact(a: &Cap, b: &Cap) -> f32 {
     lens_area_exact(&a.to64(), &b.to64()) as f32
 }
 
 /// Area of a ∩ b with the Oat–Sander "ambient aperture" approximation (exact when one cap
 /// contains the other or they are disjoint; a smoothstep blend otherwise). This is what the SPTD
-/// reference code uses.
+/// reference code uses. In steradians, never above the smaller cap's solid angle.
 pub fn intersection_area_oat_sander(a: &Cap, b: &Cap) -> f32 {
     lens_area_oat_sander(&a.to64(), &b.to64()) as f32
 }

@@ -21,7 +21,11 @@ use glam::DVec3;
 use std::f64::consts::PI;
 
 /// GGX lobe samples for one (θo, α) cell.
+///
+/// Directions are in the local frame (z = normal) with ωo in the xz-plane; only those above the
+/// horizon are kept.
 pub struct CellSamples {
+    /// Sample directions wi (unit, z > 0).
     pub dirs: Vec<DVec3>,
     /// f·cos at `dirs`.
     pub f: Vec<f64>,
@@ -29,9 +33,12 @@ pub struct CellSamples {
     pub w: Vec<f64>,
 }
 
+/// Share of the `n` samples drawn by visible-normal sampling; the rest are uniform on H.
 pub const VNDF_FRACTION: f64 = 0.75;
 
 impl CellSamples {
+    /// Draws `n` samples (before dropping those below the horizon) for GGX roughness `alpha`
+    /// and the unit view direction `wo`, deterministically from `seed`.
     pub fn new(alpha: f64, wo: DVec3, n: usize, seed: u64) -> Self {
         let mut rng = SplitMix64::new(seed);
         let s1 = R2::new(&mut rng);
@@ -64,7 +71,8 @@ impl CellSamples {
         Self { dirs, f, w }
     }
 
-    /// Estimate of ∫_H |f·cos − g|.
+    /// Estimate of ∫_H |f·cos − g| dω, for `g` a density-like function of a unit local-frame
+    /// direction (same units as f·cos, i.e. per steradian).
     pub fn l1(&self, g: impl Fn(DVec3) -> f64) -> f64 {
         let mut s = 0.0;
         for i in 0..self.dirs.len() {
@@ -87,12 +95,19 @@ impl CellSamples {
 /// GGX lobe (visible-normal samples), uniformly on H and at the lobe's mean direction; half-angles
 /// log-uniform in [0.002, 1] rad.
 pub struct CellCaps {
+    /// The test caps, in the local frame.
     pub caps: Vec<Cap64>,
+    /// Reference ∫_{C∩H} f·cos dω of each cap, same order as `caps`.
     pub refs: Vec<f64>,
+    /// Offset added to both sides of the log-ratio (1 % of the mean reference value) so that
+    /// caps with near-zero integrals do not dominate.
     pub eps: f64,
 }
 
 impl CellCaps {
+    /// Builds `count` caps for GGX roughness `alpha`, unit view direction `wo` and the lobe's
+    /// unit mean direction `mean_dir`, each with a reference integral of `ref_samples`
+    /// samples; deterministic in `seed`.
     pub fn new(
         alpha: f64,
         wo: DVec3,
@@ -228,9 +243,13 @@ pub fn nelder_mead(
 /// The fit grid shared by both tables: 64 × 64 cells, θo = i/63 · π/2 (fitted at
 /// min(θo, [`THETA_FIT_MAX`])) and √α = j/63 (fitted at max(α, [`ALPHA_MIN`])).
 pub const N: usize = 64;
+/// Largest θo (radians, 89.5°) a cell is fitted at; the last row sits at π/2.
 pub const THETA_FIT_MAX: f64 = 1.5620696805349; // 89.5°
+/// Smallest GGX α a cell is fitted at; the first column sits at α = 0.
 pub const ALPHA_MIN: f64 = 0.001;
 
+/// `(θo, α)` at which cell `(i, j)` is fitted, i, j ∈ [0, [`N`]): θo in radians, α the GGX
+/// roughness (not √α), both with the limits above applied.
 pub fn cell_params(i: usize, j: usize) -> (f64, f64) {
     let theta = (i as f64 / (N - 1) as f64 * std::f64::consts::FRAC_PI_2).min(THETA_FIT_MAX);
     let s = j as f64 / (N - 1) as f64;

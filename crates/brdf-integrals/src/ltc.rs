@@ -30,6 +30,7 @@ use std::sync::{Arc, OnceLock};
 
 /// Channels: m0, m1, m2, m3 (M⁻¹ entries), albedo A, fitted relative L1 error.
 pub type LtcTable = Table<6>;
+/// File magic of a serialised [`LtcTable`] (see [`Table::to_bytes`]).
 pub const MAGIC: &[u8; 8] = b"LTCGGX01";
 
 static DEFAULT_BYTES: &[u8] = include_bytes!("../data/ltc_ggx_64x64.bin");
@@ -44,9 +45,13 @@ pub fn default_table() -> Arc<LtcTable> {
         .clone()
 }
 
+/// The LTC cap-integral method: a fitted table plus its lookup mode. Cheap to clone (the table
+/// is shared). [`Ltc::default`] uses the committed table with bilinear lookup.
 #[derive(Clone, Debug)]
 pub struct Ltc {
+    /// Per-cell M⁻¹ entries and albedo over (θo, √α); see [`LtcTable`].
     pub table: Arc<LtcTable>,
+    /// How the table is interpolated.
     pub lookup: Lookup,
 }
 
@@ -57,12 +62,14 @@ impl Default for Ltc {
 }
 
 impl Ltc {
+    /// The method with a given table (e.g. a refit) and bilinear lookup.
     pub fn with_table(table: Arc<LtcTable>) -> Self {
         Self {
             table,
             lookup: Lookup::default(),
         }
     }
+    /// Builder: sets [`Ltc::lookup`].
     pub fn lookup(mut self, lookup: Lookup) -> Self {
         self.lookup = lookup;
         self
@@ -89,7 +96,8 @@ pub struct LtcLobe {
 }
 
 impl LtcLobe {
-    /// From M⁻¹ in the local frame and the albedo.
+    /// From M⁻¹ in the local frame (invertible) and the albedo A, the value the lobe
+    /// gives the whole upper hemisphere.
     pub fn new(minv: DMat3, albedo: f32) -> Self {
         let m = minv.inverse();
         let n = m.transpose() * DVec3::Z;
@@ -114,7 +122,8 @@ impl LtcLobe {
         }
     }
 
-    /// LTC density D(ω) (normalised over the sphere).
+    /// LTC density D(ω) per steradian at the unit local-frame direction `w` (normalised over the
+    /// sphere, not the hemisphere).
     pub fn ltc_density(&self, w: DVec3) -> f64 {
         let v = self.minv * w;
         let l2 = v.length_squared();
@@ -356,13 +365,20 @@ pub fn minv_from_params(theta_z: f64, m11: f64, m22: f64, m13: f64) -> DMat3 {
     minv * (1.0 / minv.y_axis.y)
 }
 
+/// Fit report of one LTC cell.
 #[derive(Clone, Copy, Debug)]
 pub struct LtcCellFit {
+    /// Fitted M⁻¹ for ωo on +x, scaled so that M⁻¹_yy = 1.
     pub minv: DMat3,
+    /// The optimiser's parameters (ln m11, ln m22, m13), see [`minv_from_params`].
     pub params: [f64; 3],
+    /// Reference GGX directional albedo A of the cell.
     pub albedo: f64,
+    /// ∫_H |f·cos − g| / A at the fit: relative L1 error of the lobe (0 = exact).
     pub rel_l1: f64,
+    /// Mean squared log-ratio of fitted to reference cap integrals ([`CellCaps::log_err`]).
     pub log_err: f64,
+    /// The minimised objective, `rel_l1 + log_err` (`f64::MAX` where that was not finite).
     pub objective: f64,
 }
 

@@ -137,6 +137,8 @@ pub struct CapSampler {
 }
 
 impl CapSampler {
+    /// A sampler for `cap` under the SPTD with pivot `pivot` (|pivot| < 1), both in the same
+    /// frame (the lobe's local frame for [`crate::SptdLobe::cap_sampler`]).
     pub fn new(pivot: Vec3, cap: &Cap) -> Self {
         let pivot = pivot.as_dvec3();
         let cap = cap.to64();

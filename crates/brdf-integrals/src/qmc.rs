@@ -6,9 +6,11 @@
 pub struct SplitMix64(pub u64);
 
 impl SplitMix64 {
+    /// A generator started from `seed` (any value; equal seeds give equal streams).
     pub fn new(seed: u64) -> Self {
         Self(seed ^ 0x9E37_79B9_7F4A_7C15)
     }
+    /// Next 64 uniformly distributed bits.
     pub fn next_u64(&mut self) -> u64 {
         self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
         let mut z = self.0;
@@ -34,11 +36,13 @@ const R2_A1: f64 = 0.754_877_666_246_692_8; // 1/g, g = plastic number
 const R2_A2: f64 = 0.569_840_290_998_053_3; // 1/g^2
 
 impl R2 {
+    /// A sequence with a random shift drawn from `rng`.
     pub fn new(rng: &mut SplitMix64) -> Self {
         Self {
             shift: [rng.next_f64(), rng.next_f64()],
         }
     }
+    /// Point `i` of the shifted sequence, in [0, 1)².
     #[inline]
     pub fn get(&self, i: usize) -> [f64; 2] {
         let i = i as f64;

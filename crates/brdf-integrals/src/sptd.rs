@@ -23,6 +23,7 @@ use std::sync::{Arc, OnceLock};
 
 /// Channels: ρ, θp, albedo A, fitted relative L1 error (∫|f·cos − g| / A).
 pub type SptdTable = Table<4>;
+/// File magic of a serialised [`SptdTable`] (see [`Table::to_bytes`]).
 pub const MAGIC: &[u8; 8] = b"SPTDGGX1";
 
 static DEFAULT_BYTES: &[u8] = include_bytes!("../data/sptd_ggx_64x64.bin");
@@ -37,6 +38,8 @@ pub fn default_table() -> Arc<SptdTable> {
         .clone()
 }
 
+/// How an SPTD lobe computes the area of T(C) ∩ T(H), the two-cap intersection behind every
+/// integral.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Intersection {
     /// Exact spherical-lens area (default).
@@ -46,6 +49,7 @@ pub enum Intersection {
     OatSander,
 }
 
+/// What an SPTD lobe's mass is divided by (see the module docs).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Normalization {
     /// A · |T(C) ∩ T(H)| / |T(H)|: the hemisphere integrates to the albedo (default).
@@ -55,11 +59,18 @@ pub enum Normalization {
     FullSphere,
 }
 
+/// The SPTD cap-integral method: a fitted table plus the evaluation options. Cheap to clone
+/// (the table is shared). [`Sptd::default`] uses the committed table and the default of every
+/// option.
 #[derive(Clone, Debug)]
 pub struct Sptd {
+    /// Per-cell pivot and albedo over (θo, √α); see [`SptdTable`].
     pub table: Arc<SptdTable>,
+    /// How the table is interpolated.
     pub lookup: Lookup,
+    /// How cap intersection areas are computed.
     pub intersection: Intersection,
+    /// How the lobe is normalised.
     pub normalization: Normalization,
 }
 
@@ -70,6 +81,7 @@ impl Default for Sptd {
 }
 
 impl Sptd {
+    /// The method with a given table (e.g. a refit) and default options.
     pub fn with_table(table: Arc<SptdTable>) -> Self {
         Self {
             table,
@@ -78,19 +90,24 @@ impl Sptd {
             normalization: Normalization::default(),
         }
     }
+    /// Builder: sets [`Sptd::lookup`].
     pub fn lookup(mut self, lookup: Lookup) -> Self {
         self.lookup = lookup;
         self
     }
+    /// Builder: sets [`Sptd::intersection`].
     pub fn intersection(mut self, intersection: Intersection) -> Self {
         self.intersection = intersection;
         self
     }
+    /// Builder: sets [`Sptd::normalization`].
     pub fn normalization(mut self, normalization: Normalization) -> Self {
         self.normalization = normalization;
         self
     }
-    /// Table entry (ρ, θp, A) for (θo, α).
+    /// Table entry (ρ, θp, A) for view angle θo (radians) and GGX α: pivot distance ρ ∈ [0, 1),
+    /// pivot elevation θp in radians (for ωo in the +x half of the xz-plane; negative = mirror
+    /// side) and directional albedo A.
     pub fn params(&self, theta_o: f32, alpha: f32) -> (f32, f32, f32) {
         let c = self.table.lookup(theta_o, alpha, self.lookup);
         (c[0], c[1], c[2])
@@ -124,6 +141,7 @@ pub(crate) fn theta_of(wo: Vec3) -> f32 {
 /// Per-shading-point SPTD lobe: the pivot, T(H) and the scale.
 #[derive(Clone, Copy, Debug)]
 pub struct SptdLobe {
+    /// The pivot r in the local frame (z = normal), |r| < 1; its azimuth follows ωo's.
     pub pivot: Vec3,
     pivot64: DVec3,
     th: Cap64,
@@ -133,6 +151,8 @@ pub struct SptdLobe {
 }
 
 impl SptdLobe {
+    /// A lobe from its pivot (local frame, |pivot| < 1), its albedo A (the value over the
+    /// whole upper hemisphere with [`Normalization::Hemisphere`]) and the options.
     pub fn new(
         pivot: DVec3,
         albedo: f32,
@@ -215,12 +235,19 @@ impl CapIntegral for Sptd {
 /// Fit report of one cell.
 #[derive(Clone, Copy, Debug)]
 pub struct CellFit {
+    /// Fitted pivot distance ρ ∈ (0, 1).
     pub rho: f64,
+    /// Fitted pivot elevation θp in radians, in [−π/2, π/2] (ωo on +x; negative = mirror side).
     pub theta_p: f64,
+    /// Reference GGX directional albedo A of the cell.
     pub albedo: f64,
+    /// ∫_H |f·cos − g| / A at the fit: relative L1 error of the lobe (0 = exact).
     pub rel_l1: f64,
+    /// Mean squared log-ratio of fitted to reference cap integrals ([`CellCaps::log_err`]).
     pub log_err: f64,
+    /// The minimised objective, `rel_l1 + log_err`.
     pub objective: f64,
+    /// Objective evaluations spent by the winning start.
     pub evals: usize,
 }
 
@@ -316,8 +343,9 @@ pub fn fit_cell(
 }
 
 const FRAC_PI_2_64: f64 = std::f64::consts::FRAC_PI_2;
-/// Test caps per cell in the fit objective and reference samples per cap.
+/// Test caps per cell in the fit objective (shared by the LTC fit).
 pub const CAPS_PER_CELL: usize = 96;
+/// Reference-integrator samples per test cap in the fit objective.
 pub const CAP_REF_SAMPLES: usize = 2048;
 
 /// Heuristic initial pivot: 1 − ρ ≈ 2α matches the peak height at normal incidence.

@@ -2,18 +2,24 @@
 //! small header, and its bilinear / nearest lookup.
 //!
 //! File layout: 8-byte magic, then u32 n_theta, n_alpha, channels (LE), then
-//! n_theta · n_alpha · channels f32 (LE), row-major [θ index][√α index][channel].
+//! n_theta · n_alpha · channels f32 (LE), row-major \[θ index\]\[√α index\]\[channel\].
 //! Grid: θo = i/(n_theta − 1) · π/2, √α = j/(n_alpha − 1).
 
 use std::f32::consts::FRAC_PI_2;
 
+/// A regular grid over θo ∈ [0, π/2] × √α ∈ [0, 1] holding `C` values per cell (what each
+/// channel means is up to the user, e.g. [`crate::sptd::SptdTable`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Table<const C: usize> {
+    /// Grid points along θo (≥ 2 for lookups), from 0 to π/2 inclusive.
     pub n_theta: usize,
+    /// Grid points along √α (≥ 2 for lookups), from 0 to 1 inclusive.
     pub n_alpha: usize,
+    /// `n_theta · n_alpha` cells, θo-major: cell (i, j) is at `i · n_alpha + j`.
     pub cells: Vec<[f32; C]>,
 }
 
+/// How a table is read between its grid points.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Lookup {
     /// Bilinear interpolation between the four surrounding cells (default).
@@ -24,6 +30,7 @@ pub enum Lookup {
 }
 
 impl<const C: usize> Table<C> {
+    /// A table of the given size with every channel 0.
     pub fn new(n_theta: usize, n_alpha: usize) -> Self {
         Self {
             n_theta,
@@ -32,14 +39,17 @@ impl<const C: usize> Table<C> {
         }
     }
 
+    /// Cell at θo index `i` and √α index `j` (panics out of range).
     pub fn cell(&self, i: usize, j: usize) -> &[f32; C] {
         &self.cells[i * self.n_alpha + j]
     }
 
+    /// Mutable [`Table::cell`].
     pub fn cell_mut(&mut self, i: usize, j: usize) -> &mut [f32; C] {
         &mut self.cells[i * self.n_alpha + j]
     }
 
+    /// Serialises the table in the file layout of the module docs, starting with `magic`.
     pub fn to_bytes(&self, magic: &[u8; 8]) -> Vec<u8> {
         let mut out = Vec::with_capacity(20 + self.cells.len() * C * 4);
         out.extend_from_slice(magic);
@@ -54,6 +64,9 @@ impl<const C: usize> Table<C> {
         out
     }
 
+    /// Parses a table written by [`Table::to_bytes`]. Fails (with a message) on a wrong
+    /// magic, a channel count other than `C`, fewer than 2 grid points on an axis or a size
+    /// that does not match the header.
     pub fn from_bytes(bytes: &[u8], magic: &[u8; 8]) -> Result<Self, String> {
         if bytes.len() < 20 || &bytes[..8] != magic {
             return Err("bad table header".into());
@@ -86,6 +99,8 @@ impl<const C: usize> Table<C> {
         (x, y)
     }
 
+    /// The channels at view angle `theta_o` (radians) and GGX roughness `alpha` (α, not √α;
+    /// the table is indexed by √α). Both are clamped to the grid: θo to [0, π/2], α to [0, 1].
     #[inline]
     pub fn lookup(&self, theta_o: f32, alpha: f32, mode: Lookup) -> [f32; C] {
         let (x, y) = self.coords(theta_o, alpha);

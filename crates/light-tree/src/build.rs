@@ -197,6 +197,8 @@ fn make_node(agg: &Agg, depth: u32, child_or_light: u32, leaf: bool) -> (Node, N
 
 /// V[Φ]/E[Φ]² of `n` lights of total power `sum` and Σ Φ² `sum_sq`, with the sample variance
 /// (n − 1): n·(n·ΣΦ²/Φ² − 1)/(n − 1); 0 for one light or zero total power.
+// `!(sum > 0.0)` is meant to be true for NaN as well as for sum ≤ 0.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 fn power_cv2(n: u32, sum: f64, sum_sq: f64) -> f64 {
     if n <= 1 || !(sum > 0.0) {
         return 0.0;

@@ -12,8 +12,12 @@ const UNION_SLACK: f32 = 1e-5;
 /// leaves each normal at most `theta_e` away from it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Cone {
+    /// Central direction of the bounded normals (unit length).
     pub axis: Vec3,
+    /// Half-angle in radians around `axis` holding every normal: [0, π], π meaning any
+    /// direction; negative only for [`Cone::EMPTY`].
     pub theta_o: f32,
+    /// Largest angle in radians between emitted light and its normal, in [0, π].
     pub theta_e: f32,
 }
 
@@ -25,6 +29,7 @@ impl Cone {
         theta_e: 0.0,
     };
 
+    /// Whether this is the empty cone (bounds no normal at all), i.e. `theta_o < 0`.
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.theta_o < 0.0
@@ -94,7 +99,8 @@ impl Cone {
     }
 
     /// Orientation measure M_Ω = 2π(1−cos θo) + π/2·[2θw sin θo − cos(θo−2θw) − 2θo sin θo + cos θo],
-    /// θw = min(θo+θe, π).
+    /// θw = min(θo+θe, π): the SAOH's weight for how spread out the emission directions are,
+    /// in [0, 4π] (4π for the full sphere).
     pub fn measure(&self) -> f32 {
         if self.theta_o >= PI {
             return 4.0 * PI;

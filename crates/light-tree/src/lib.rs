@@ -18,7 +18,52 @@
 //! (with conservative bounds, every light below is dark at `x`), so Σ pmf over all lights is
 //! 1 − P(None): exactly 1 without such dead ends, 0 when everything is dark.
 //!
+//! All positions, directions and boxes are in one space of the caller's choosing (usually world
+//! space); the tree never transforms them. Angles are in radians. Powers only need a common unit:
+//! the pmfs are ratios of importances, so scaling every power leaves them unchanged.
+//!
 //! See `README.md` for units, conventions and measured performance.
+//!
+//! # Example
+//!
+//! Build a tree over three lights and pick one of them for a shading point, with the
+//! probability it was picked:
+//!
+//! ```
+//! use glam::Vec3;
+//! use light_tree::{LightBounds, LightTree};
+//! use std::f32::consts::FRAC_PI_2;
+//!
+//! let lights = [
+//!     // Two isotropic point lights (intensity in W/sr).
+//!     LightBounds::point(Vec3::new(0.0, 0.0, 2.0), 1.0),
+//!     LightBounds::point(Vec3::new(3.0, 0.0, 1.0), 5.0),
+//!     // A one-sided 2 × 2 Lambertian quad at height 3, facing down.
+//!     LightBounds {
+//!         aabb_min: Vec3::new(-1.0, -1.0, 3.0),
+//!         aabb_max: Vec3::new(1.0, 1.0, 3.0),
+//!         axis: -Vec3::Z,
+//!         theta_o: 0.0,
+//!         theta_e: FRAC_PI_2,
+//!         power: 10.0,
+//!         two_sided: false,
+//!     },
+//! ];
+//! let tree = LightTree::build(&lights).expect("valid bounds");
+//! assert_eq!(tree.num_lights(), 3);
+//!
+//! // Shading point at the origin on a floor facing +z; `u` is one uniform number in [0, 1).
+//! let (x, n, u) = (Vec3::ZERO, Vec3::Z, 0.37);
+//! let (light, pmf) = tree.sample(x, n, u).expect("every light can reach x");
+//! assert!(light < lights.len() && pmf > 0.0 && pmf <= 1.0);
+//! // The pmf can be recomputed for any light (e.g. for MIS), bit for bit.
+//! assert_eq!(tree.pmf(x, n, light), pmf);
+//! // No light is dark here, so the pmf sums to one over the lights.
+//! let total: f32 = (0..lights.len()).map(|i| tree.pmf(x, n, i)).sum();
+//! assert!((total - 1.0).abs() < 1e-5);
+//! ```
+
+#![warn(missing_docs)]
 
 mod build;
 mod cone;
@@ -53,17 +98,30 @@ pub const MAX_DEPTH: u32 = 64;
 /// * `two_sided`: the emitter also emits around `-axis` (e.g. a two-sided quad).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightBounds {
+    /// Lower corner of an axis-aligned box enclosing the emitter (`aabb_min <= aabb_max` on
+    /// every axis; equal to `aabb_max` for a point light).
     pub aabb_min: Vec3,
+    /// Upper corner of the enclosing box.
     pub aabb_max: Vec3,
+    /// Central direction of the emitting normals. Any non-zero length (`build` normalises
+    /// it); may be zero only when `theta_o` is π.
     pub axis: Vec3,
+    /// Half-angle, in radians in [0, π], of the cone around `axis` that holds every emitting
+    /// normal.
     pub theta_o: f32,
+    /// How far, in radians in [0, π], emitted light can stray from its normal (π/2 for a
+    /// Lambertian emitter).
     pub theta_e: f32,
+    /// Emitted power Φ, finite and ≥ 0, in the unit shared by all lights. Zero-power lights
+    /// are kept but never sampled.
     pub power: f32,
+    /// Whether the emitter also radiates around `-axis`.
     pub two_sided: bool,
 }
 
 impl LightBounds {
-    /// Bounds of an isotropic point light of intensity `intensity` (power 4π·I).
+    /// Bounds of an isotropic point light at `p` with radiant intensity `intensity` (power
+    /// 4π·I; θo = π, θe = π/2, not two-sided).
     pub fn point(p: Vec3, intensity: f32) -> Self {
         Self {
             aabb_min: p,
@@ -85,15 +143,32 @@ pub enum BuildError {
     /// More lights than the 32-bit node indices can address (2³¹ − 1 at most).
     TooManyLights(usize),
     /// A field of light `light` is NaN or infinite.
-    NonFinite { light: usize },
+    NonFinite {
+        /// Index of the rejected light in the slice given to [`LightTree::build`].
+        light: usize,
+    },
     /// Light `light` has negative power.
-    NegativePower { light: usize, power: f32 },
+    NegativePower {
+        /// Index of the rejected light.
+        light: usize,
+        /// The negative power it was given.
+        power: f32,
+    },
     /// `aabb_min > aabb_max` on some axis.
-    InvertedBounds { light: usize },
+    InvertedBounds {
+        /// Index of the rejected light.
+        light: usize,
+    },
     /// `theta_o` or `theta_e` outside [0, π].
-    AngleOutOfRange { light: usize },
+    AngleOutOfRange {
+        /// Index of the rejected light.
+        light: usize,
+    },
     /// Zero-length `axis` while `theta_o < π`.
-    ZeroAxis { light: usize },
+    ZeroAxis {
+        /// Index of the rejected light.
+        light: usize,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -139,6 +214,10 @@ const FLAG_HALF_SPACE: u8 = 4;
 /// One node of the flattened tree: exactly one cache line holding everything the importance
 /// and the descent touch. Rarely used data (exact cone angles, Σ Φ²) lives in
 /// [`LightTree::node_extra`].
+///
+/// A node bounds all the lights of its subtree: the box is the union of their boxes, the cone
+/// (axis, θo, θe) contains all their cones, and the power is their sum. Nodes are read-only
+/// views obtained from [`LightTree::nodes`] or [`LightTree::node`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C, align(64))]
 pub struct Node {
@@ -159,12 +238,14 @@ pub struct Node {
 /// Per-node data that queries rarely need.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NodeExtra {
-    /// Cone half-angles (exact values of the union; `Node` only keeps their cosines).
+    /// Normal-spread half-angle θo of the node's cone, radians in [0, π] (exact value of the
+    /// union; `Node` only keeps its cosine).
     pub theta_o: f32,
+    /// Emission half-angle θe of the node's cone, radians in [0, π] (the largest θe below).
     pub theta_e: f32,
     /// Σ Φᵢ² over the subtree's lights (for the E&K variance metric).
     pub power_sq_sum: f32,
-    /// V[Φ]/E[Φ]² over the subtree's lights (sample variance, N − 1): the squared coefficient
+    /// V\[Φ\]/E\[Φ\]² over the subtree's lights (sample variance, N − 1): the squared coefficient
     /// of variation of the lights' powers, unit-free; 0 for one light or zero power.
     pub power_cv2: f32,
 }
@@ -190,10 +271,14 @@ impl Node {
     pub fn axis(&self) -> Vec3 {
         self.axis
     }
+    /// cos θo: cosine of the half-angle around [`Node::axis`] that holds every emitting normal
+    /// of the subtree (−1 when the normals may point anywhere).
     #[inline]
     pub fn cos_theta_o(&self) -> f32 {
         self.cos_theta_o
     }
+    /// cos θe: cosine of the largest angle between emitted light and its normal in the
+    /// subtree (0 for Lambertian emitters).
     #[inline]
     pub fn cos_theta_e(&self) -> f32 {
         self.cos_theta_e
@@ -203,6 +288,7 @@ impl Node {
     pub fn power(&self) -> f32 {
         self.power
     }
+    /// Number of lights in the subtree (1 for a leaf).
     #[inline]
     pub fn num_lights(&self) -> usize {
         self.num_lights as usize
@@ -217,6 +303,7 @@ impl Node {
     pub fn depth(&self) -> u32 {
         self.depth as u32
     }
+    /// Whether the node is a leaf, i.e. holds exactly one light ([`Node::light`]).
     #[inline]
     pub fn is_leaf(&self) -> bool {
         self.flags & FLAG_LEAF != 0
@@ -244,6 +331,9 @@ impl Node {
 }
 
 /// A light BVH flattened depth-first; see the crate docs.
+///
+/// Lights are identified by their index in the slice given to [`LightTree::build`]; nodes by a
+/// [`NodeId`]. The tree is immutable once built and can be shared between threads.
 #[derive(Clone, Debug)]
 pub struct LightTree {
     nodes: Vec<Node>,
@@ -261,14 +351,17 @@ impl LightTree {
     pub fn nodes(&self) -> &[Node] {
         &self.nodes
     }
+    /// The node with id `id`. Panics if `id` is out of range.
     #[inline]
     pub fn node(&self, id: NodeId) -> &Node {
         &self.nodes[id as usize]
     }
+    /// Id of the root node (always 0).
     #[inline]
     pub fn root(&self) -> NodeId {
         0
     }
+    /// Number of lights the tree was built from (= number of leaves).
     #[inline]
     pub fn num_lights(&self) -> usize {
         self.leaf_of.len()

@@ -14,6 +14,9 @@ const MIN_DIST_SQ: f32 = 1e-12;
 const MIN_EMIT_COS: f32 = 1e-3;
 
 /// Source of the random decisions in a descent.
+///
+/// Implement it to drive [`LightTree::sample_subtree`] with your own sampler; [`Rescaled`]
+/// and [`Fresh`] are the two ready-made choices.
 pub trait DescentRandom {
     /// Returns `true` (go left) with probability `p_left`, `0 < p_left < 1`.
     fn go_left(&mut self, p_left: f32) -> bool;
@@ -22,7 +25,10 @@ pub trait DescentRandom {
 /// One uniform number in [0, 1) rescaled at every level (E&K / pbrt-v4 style). Loses about
 /// one bit of precision per level.
 #[derive(Clone, Copy, Debug)]
-pub struct Rescaled(pub f32);
+pub struct Rescaled(
+    /// The current uniform number in [0, 1), rescaled in place after every decision.
+    pub f32,
+);
 
 impl DescentRandom for Rescaled {
     #[inline]
@@ -40,7 +46,11 @@ impl DescentRandom for Rescaled {
 
 /// A fresh uniform number in [0, 1) per level (Liu et al.'s improvement), drawn from the
 /// wrapped closure.
-pub struct Fresh<F: FnMut() -> f32>(pub F);
+pub struct Fresh<F: FnMut() -> f32>(
+    /// Called once per random decision (an interior node whose two children both have
+    /// non-zero importance); must return independent uniform numbers in [0, 1).
+    pub F,
+);
 
 impl<F: FnMut() -> f32> DescentRandom for Fresh<F> {
     #[inline]
@@ -155,14 +165,19 @@ impl Node {
 /// A cut through the tree: node ids sorted by DFS id, whose subtrees partition the lights.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Cut {
+    /// The cut's nodes in increasing [`NodeId`] order; every light lies under exactly one of
+    /// them (for cuts made by [`LightTree::cut`] and friends).
     pub nodes: Vec<NodeId>,
 }
 
 impl Cut {
+    /// Number of nodes (clusters) in the cut.
     #[inline]
     pub fn len(&self) -> usize {
         self.nodes.len()
     }
+    /// Whether the cut has no node (only the [`Default`] value; real cuts hold at least the
+    /// root).
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
@@ -210,16 +225,17 @@ impl LightTree {
 
     /// The σ behind E&K's splitting (their eqs. 8–10), for a node of N lights whose bounding
     /// sphere (c, r) lies at distance d from `x`: distances uniform in [a, b] = [d − r, d + r]
-    /// give the geometric term g = 1/dist² the mean E[g] = 1/(ab) and the variance
-    /// V[g] = (b³ − a³)/(3(b − a)a³b³) − 1/(a²b²); the lights' powers give E[e] = Φ/N and V[e].
+    /// give the geometric term g = 1/dist² the mean E\[g\] = 1/(ab) and the variance
+    /// V\[g\] = (b³ − a³)/(3(b − a)a³b³) − 1/(a²b²); the lights' powers give E\[e\] = Φ/N and
+    /// V\[e\].
     ///
-    /// * [`SplitCriterion::Authors`]: σ = N·√(V[e]V[g] + V[e]E[g]² + E[e]²V[g]) in scene
-    ///   units (power / length²), with the authors' V[e] = ⌊1/(N − 1)⌋·(ΣΦ² − N·E[e]²): their
-    ///   integer division makes it 0 for N ≥ 3; a = max(d − r, 1e-9).
+    /// * [`SplitCriterion::Authors`]: σ = N·√(V\[e\]V\[g\] + V\[e\]E\[g\]² + E\[e\]²V\[g\]) in
+    ///   scene units (power / length²), with the authors' V\[e\] = ⌊1/(N − 1)⌋·(ΣΦ² − N·E\[e\]²):
+    ///   their integer division makes it 0 for N ≥ 3; a = max(d − r, 1e-9).
     /// * [`SplitCriterion::UnitFree`]: the same σ over the node's expected contribution
-    ///   N·E[e]·E[g], i.e. the coefficient of variation of a one-light estimate of the node,
-    ///   √((1 + V[e]/E[e]²)(1 + V[g]/E[g]²) − 1) with V[g]/E[g]² = 4r²/(3(d² − r²)): scaling
-    ///   every power or every length leaves it unchanged. Infinite inside the sphere.
+    ///   N·E\[e\]·E\[g\], i.e. the coefficient of variation of a one-light estimate of the node,
+    ///   √((1 + V\[e\]/E\[e\]²)(1 + V\[g\]/E\[g\]²) − 1) with V\[g\]/E\[g\]² = 4r²/(3(d² − r²)):
+    ///   scaling every power or every length leaves it unchanged. Infinite inside the sphere.
     ///
     /// Leaves return 0.
     pub fn split_sigma(&self, node: NodeId, x: Vec3, criterion: SplitCriterion) -> f64 {
@@ -307,6 +323,9 @@ impl LightTree {
     ///   when the node's box lies wholly behind the receiver's tangent plane, or when the node
     ///   is one-sided with θo + θe ≤ π/2 and `x` lies behind the box along the axis;
     /// * for θe > π/2 an emitter cosine ≤ 0 inside the emission range is floored at 1e-3.
+    ///
+    /// `x` and `n` are in the same space as the light bounds; `n` is unit length or zero. The
+    /// result is ≥ 0, in power / length² (only ratios between nodes matter to the descent).
     #[inline]
     pub fn importance(&self, node: NodeId, x: Vec3, n: Vec3) -> f32 {
         self.nodes[node as usize].importance(x, n)
@@ -315,6 +334,10 @@ impl LightTree {
     /// Samples one light by a single descent from the root with one rescaled `u` ∈ [0, 1).
     /// Returns `(light, pmf)`, or `None` when the descent reaches a node whose children
     /// both have zero importance (with conservative bounds those lights cannot reach `x`).
+    ///
+    /// `light` indexes the slice given to [`LightTree::build`]; `pmf` ∈ (0, 1] is the discrete
+    /// probability of that choice (not a density), equal to [`LightTree::pmf`] for it. `x` and
+    /// `n` are as in [`LightTree::importance`].
     #[inline]
     pub fn sample(&self, x: Vec3, n: Vec3, u: f32) -> Option<(usize, f32)> {
         self.sample_subtree(
@@ -335,6 +358,10 @@ impl LightTree {
     /// Generic descent from `start`: at each interior node go left with probability
     /// I(left)/(I(left)+I(right)) (NaN/negative importances count as 0). Returns
     /// `(light, pmf within the subtree)`, or `None` at a dead end (both children 0).
+    ///
+    /// `importance` maps a node id to any non-negative weight (e.g. [`LightTree::importance`]
+    /// or a BRDF-aware one); it is called for both children at each level. `rng` makes the
+    /// left/right decisions. A leaf `start` returns its light with pmf 1.
     pub fn sample_subtree<I, R>(
         &self,
         start: NodeId,
@@ -497,7 +524,7 @@ pub enum SplitCriterion {
     /// scale or brightness changes no cut (our default).
     #[default]
     UnitFree,
-    /// bisml's σ in scene units with its zeroed V[e] (`--reproduce`).
+    /// bisml's σ in scene units with its zeroed V\[e\] (`--reproduce`).
     Authors,
 }
 
@@ -508,6 +535,7 @@ pub struct SplitParams {
     pub tau: f32,
     /// Most nodes in the cut (`usize::MAX`: no cap, as in the authors' code).
     pub max_size: usize,
+    /// Which σ is compared with τ.
     pub criterion: SplitCriterion,
 }
 
