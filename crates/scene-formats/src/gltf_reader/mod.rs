@@ -1278,7 +1278,8 @@ mod tests {
     /// → a warning and the glTF material.
     #[test]
     fn extras_pbrt_materials_load_as_described() {
-        use render_core::material::{Model, Specular};
+        use render_core::bsdf::Specular;
+        use render_core::material::Model;
         let (mut doc, bin) = triangle_doc(TRI);
         let materials = [
             json!({ "name": "wall", "pbrMetallicRoughness": { "baseColorFactor": [0.1, 0.1, 0.1, 1] },
@@ -1328,7 +1329,7 @@ mod tests {
             (ks, m("remapped").base_color),
             (Vec3::splat(0.25), Vec3::splat(0.25))
         );
-        assert!((alpha - render_core::plastic::roughness_to_alpha(0.1)).abs() < 1e-7);
+        assert!((alpha - render_core::bsdf::plastic::roughness_to_alpha(0.1)).abs() < 1e-7);
 
         assert_eq!(params("no-spec").specular, Specular::None);
         assert!(matches!(params("plain").specular, Specular::Schlick { .. }));

@@ -3,12 +3,12 @@
 //! "remaproughness": false}}`. It says what glTF cannot, so it replaces the glTF reflection model:
 //! - `matte` (or pbrt-v4 `diffuse`): pure Lambert with albedo `Kd` (or `reflectance`; the glTF
 //!   base colour when absent), so BRDF-oriented sampling is skipped there;
-//! - `plastic`: pbrt-v3's plastic ([`render_core::plastic`]), pbrt-v3's defaults for absent values.
+//! - `plastic`: pbrt-v3's plastic ([`render_core::bsdf::plastic`]), pbrt-v3's defaults for absent values.
 //!
 //! Any other type, or a value of the wrong kind, is a warning and the glTF material is kept.
 use glam::Vec3;
+use render_core::bsdf::plastic;
 use render_core::material::{Material, Model};
-use render_core::plastic;
 use serde_json::Value;
 
 /// `Ok` with the material `extras.pbrt` describes (or `gltf` unchanged when there is none), or

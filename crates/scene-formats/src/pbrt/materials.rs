@@ -3,7 +3,7 @@
 //! | pbrt | here |
 //! |---|---|
 //! | `matte` (v3), `diffuse` (v4): `Kd` / `reflectance` | pure Lambert (no BRDF-oriented sampling there) |
-//! | `plastic` (v3): `Kd`, `Ks`, `roughness`, `remaproughness` | pbrt-v3's plastic ([`render_core::plastic`]) |
+//! | `plastic` (v3): `Kd`, `Ks`, `roughness`, `remaproughness` | pbrt-v3's plastic ([`render_core::bsdf::plastic`]) |
 //! | `coateddiffuse` (v4): `reflectance`, `roughness`, `remaproughness` | the glTF dielectric (Lambert + GGX, Schlick F0 = 0.04), with a warning |
 //! | `conductor` (v4), `metal` (v3): `reflectance`, or `eta` + `k`, `roughness` | the glTF metal, F0 = reflectance or the normal-incidence Fresnel of η + ik |
 //! | `dielectric` (v4), `glass` (v3): `eta`, `roughness` | an opaque black dielectric coat (F0 = ((η−1)/(η+1))²), with a warning |
@@ -12,8 +12,8 @@
 //! Parameters may name a texture; constant textures are used as their value, any other
 //! texture as the parameter's default, with a warning.
 use glam::Vec3;
+use render_core::bsdf::plastic;
 use render_core::material::Material;
-use render_core::plastic;
 use std::collections::HashMap;
 
 use super::params::ParamList;

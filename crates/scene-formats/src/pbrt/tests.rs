@@ -1,8 +1,9 @@
 //! The pbrt loader against small scenes written by the tests.
 use super::*;
 use glam::{Vec2, Vec3};
+use render_core::bsdf::Specular;
 use render_core::light::LightShape;
-use render_core::material::{Model, Specular};
+use render_core::material::Model;
 use std::path::PathBuf;
 
 fn dir(test: &str) -> PathBuf {

@@ -5,11 +5,17 @@
 //! Directions are in world space; the BSDF works in the local frame of the shading normal,
 //! flipped to the viewer's side. A direction below the geometric surface (as seen from the
 //! viewer) gets zero: this renderer has no transmission.
+pub mod fresnel;
+pub mod microfacet;
+mod params;
+pub mod plastic;
+
+pub use params::{BsdfParams, Specular};
+
 use crate::colour::luminance;
 use crate::frame::Frame;
-use crate::material::{BsdfParams, Specular};
-use crate::microfacet::{Ggx, reflect};
 use glam::{Vec2, Vec3};
+use microfacet::{Ggx, reflect};
 use std::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug)]

@@ -15,7 +15,7 @@ pub fn schlick(f0: Vec3, cos_theta: f32) -> Vec3 {
 /// pbrt-v3's `plastic` evaluates this with `eta_i` = 1.5 and `eta_t` = 1 for light arriving
 /// from outside (the indices are swapped with respect to the physics), so its specular weight
 /// is 0.04 at normal incidence and 1 once the angle between ωi and the half vector passes
-/// asin(1/1.5) ≈ 41.8°. [`crate::plastic`] reproduces that on purpose.
+/// asin(1/1.5) ≈ 41.8°. [`crate::bsdf::plastic`] reproduces that on purpose.
 pub fn dielectric(cos_i: f32, eta_i: f32, eta_t: f32) -> f32 {
     let mut cos_i = cos_i.clamp(-1.0, 1.0);
     let (mut eta_i, mut eta_t) = (eta_i, eta_t);

@@ -1,9 +1,9 @@
 //! pbrt-v3's `plastic` material: f = Kd/π + Ks · D · G · F / (4 cos θo cos θi), with a
 //! Trowbridge–Reitz (GGX) D, height-correlated Smith G and pbrt-v3's `FresnelDielectric(1.5, 1)`
 //! evaluated at the angle between ωi and the half vector, whose swapped indices make it total
-//! reflection past 41.8° ([`crate::fresnel::dielectric`]). The two lobes are added with no
+//! reflection past 41.8° ([`crate::bsdf::fresnel::dielectric`]). The two lobes are added with no
 //! coupling, and sampling picks either with probability ½, as pbrt-v3's BSDF does over its
-//! BxDFs. [`crate::bsdf::Bsdf`] evaluates and samples it ([`crate::material::Specular::PbrtPlastic`]);
+//! BxDFs. [`crate::bsdf::Bsdf`] evaluates and samples it ([`crate::bsdf::Specular::PbrtPlastic`]);
 //! the glTF loader (`extras.pbrt`) and the pbrt scene loader build it here.
 use crate::material::{Material, Model};
 use glam::Vec3;
@@ -111,7 +111,7 @@ mod tests {
     /// The specular weight Ks·F at the angles of the scene README's table (Ks = 0.7).
     #[test]
     fn fresnel_weight_has_pbrt_v3_quirk() {
-        let spec = crate::material::Specular::PbrtPlastic {
+        let spec = crate::bsdf::Specular::PbrtPlastic {
             ks: Vec3::splat(0.7),
         };
         for (deg, want) in [
@@ -208,8 +208,8 @@ mod tests {
                 }
             }
             let got = sum / n as f64;
-            let want =
-                kd as f64 + ks as f64 * crate::fresnel::dielectric(theta.cos(), 1.5, 1.0) as f64;
+            let want = kd as f64
+                + ks as f64 * crate::bsdf::fresnel::dielectric(theta.cos(), 1.5, 1.0) as f64;
             assert!(
                 (got - want).abs() < 0.01 * want,
                 "kd {kd} ks {ks} θo {theta}: {got} vs {want}"
