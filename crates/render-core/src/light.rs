@@ -123,35 +123,69 @@ impl TriangleRecord {
         self.area != 0.0
     }
 
-    /// [`Light::sample`] of the triangle, with the same arithmetic in the same order (the
-    /// results are bit-identical).
+    /// [`Light::sample`] of the triangle: the same point drawing ([`TrianglePoint`]), so the
+    /// results are bit-identical.
     #[inline]
     pub fn sample(&self, x: Vec3, u: Vec2) -> Option<LightSample> {
         let (area, two_sided) = (self.area.abs(), self.area < 0.0);
-        let p = &self.p;
+        let t = TrianglePoint::sample(&self.p, self.normal, area, x, u)?;
+        // `Light::emitted` towards −wi: zero from behind a one-sided emitter.
+        if t.cos_l <= 0.0 && !two_sided || self.emission == Vec3::ZERO {
+            return None;
+        }
+        Some(t.light_sample(self.normal, self.emission))
+    }
+}
+
+/// A point drawn uniformly by area on a triangle, as seen from `x`: the geometry that
+/// [`Light::sample`] and [`TriangleRecord::sample`] share, before the emission is looked up.
+struct TrianglePoint {
+    /// Barycentric coordinates of the point (of `p[1]` and `p[2]`).
+    b: Vec2,
+    point: Vec3,
+    wi: Vec3,
+    dist: f32,
+    /// Cosine at the light between its normal and the direction back to `x`.
+    cos_l: f32,
+    /// Solid-angle density at `x`.
+    pdf: f32,
+}
+
+impl TrianglePoint {
+    /// `None` when `x` lies in the triangle's plane or on the point.
+    #[inline]
+    fn sample(p: &[Vec3; 3], normal: Vec3, area: f32, x: Vec3, u: Vec2) -> Option<TrianglePoint> {
         let b = sampling::uniform_triangle(u);
         let point = p[0] * (1.0 - b.x - b.y) + p[1] * b.x + p[2] * b.y;
         let d = point - x;
         let dist2 = d.length_squared();
         let dist = dist2.sqrt();
         let wi = d / dist;
-        let cos_l = self.normal.dot(-wi);
+        let cos_l = normal.dot(-wi);
         if dist2 <= 0.0 || cos_l.abs() <= 0.0 {
             return None;
         }
-        // `Light::emitted` towards −wi: zero from behind a one-sided emitter.
-        if cos_l <= 0.0 && !two_sided || self.emission == Vec3::ZERO {
-            return None;
-        }
-        Some(LightSample {
+        Some(TrianglePoint {
+            b,
             point,
-            normal: self.normal,
             wi,
             dist,
-            radiance: self.emission,
+            cos_l,
             pdf: dist2 / (area * cos_l.abs()),
-            is_delta: false,
         })
+    }
+
+    #[inline]
+    fn light_sample(&self, normal: Vec3, radiance: Vec3) -> LightSample {
+        LightSample {
+            point: self.point,
+            normal,
+            wi: self.wi,
+            dist: self.dist,
+            radiance,
+            pdf: self.pdf,
+            is_delta: false,
+        }
     }
 }
 
@@ -243,30 +277,14 @@ impl Light {
                 area,
                 uv,
             } => {
-                let b = sampling::uniform_triangle(u);
-                let point = p[0] * (1.0 - b.x - b.y) + p[1] * b.x + p[2] * b.y;
-                let d = point - x;
-                let dist2 = d.length_squared();
-                let dist = dist2.sqrt();
-                let wi = d / dist;
-                let cos_l = normal.dot(-wi);
-                if dist2 <= 0.0 || cos_l.abs() <= 0.0 {
-                    return None;
-                }
+                let t = TrianglePoint::sample(p, *normal, *area, x, u)?;
+                let b = t.b;
                 let tuv = uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y;
-                let radiance = self.emitted(*normal, tuv, -wi);
+                let radiance = self.emitted(*normal, tuv, -t.wi);
                 if radiance == Vec3::ZERO {
                     return None;
                 }
-                Some(LightSample {
-                    point,
-                    normal: *normal,
-                    wi,
-                    dist,
-                    radiance,
-                    pdf: dist2 / (area * cos_l.abs()),
-                    is_delta: false,
-                })
+                Some(t.light_sample(*normal, radiance))
             }
             LightShape::Sphere { center, radius } => {
                 let d = *center - x;

@@ -251,14 +251,8 @@ fn shade_camera_sample(
         sees_light = e != Vec3::ZERO;
         l += e;
     }
-    let Some(material) = hit.material else {
+    let Some(sp) = shading_point(scene, hit, wo) else {
         return (l, sees_light);
-    };
-    let params = scene.materials[material as usize].params_at(hit.uv);
-    let sp = ShadingPoint {
-        hit,
-        wo,
-        bsdf: Bsdf::new(hit.ns, hit.ng, wo, params),
     };
     ctx.counters.shading_points += 1;
     ctx.counters.glossy_points += !sp.bsdf.is_pure_diffuse() as u64;

@@ -37,6 +37,10 @@ impl Default for NodeMemo {
     }
 }
 
+// A memo on its own (for users without a scratch struct of their own) comes from a per-thread
+// pool too, so taking one does not allocate per shading point.
+crate::scratch_pool!(NodeMemo, |m| m.invalidate());
+
 impl NodeMemo {
     /// Forgets every cached value (a new shading point).
     pub fn invalidate(&mut self) {

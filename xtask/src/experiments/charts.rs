@@ -1,6 +1,5 @@
 //! Charts for the reports: log-log convergence plots (plotters into a buffer, encoded with
 //! image 0.25), and the font every text of the reports is drawn in.
-use super::compositing::save_png;
 use plotters::prelude::*;
 use plotters::style::FontStyle;
 use std::path::Path;
@@ -166,7 +165,7 @@ pub fn convergence_plot(
         panel(&r, "equal time", seconds_label, vs_seconds, floor)?;
         root.present().map_err(|e| e.to_string())?;
     }
-    save_png(path, w, h, &buf)
+    render_core::output::write_png_rgb8(path, w, h, &buf)
 }
 
 #[cfg(test)]

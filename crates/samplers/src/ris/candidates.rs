@@ -7,6 +7,8 @@
 //! technique's density at a candidate (a replay down the same few tree levels) costs lookups.
 use crate::brdf_oriented::importance::LobeDensity;
 use crate::brdf_oriented::technique::BoState;
+use crate::memo::NodeMemo;
+use crate::scratch::Pooled;
 use brdf_integrals::LobeIntegral;
 use light_tree::{LightTree, NodeId, Rescaled};
 use render_core::Vec3;
@@ -16,20 +18,15 @@ use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use std::cell::RefCell;
 
-const MEMO_SIZE: usize = 1024;
-
-/// Direct-mapped cache of the tree's importance at one shading point (pure function of the
-/// node, so a hit is bit-identical to a recomputation and sampling and replay agree).
-struct TreeMemo {
-    slots: RefCell<Vec<(NodeId, f32)>>,
-}
-
+/// The candidates of one shading point: how many of each technique, and what drawing and
+/// evaluating them needs.
 pub struct CandidateSource<'a, L> {
     scene: &'a Scene,
     tree: &'a LightTree,
     x: Vec3,
     n: Vec3,
-    memo: TreeMemo,
+    /// The tree importances of this shading point, memoised (shared by draws and replays).
+    memo: RefCell<Pooled<NodeMemo>>,
     bo: Option<&'a BoState<L>>,
     pub n_ls: u32,
     pub n_bo: u32,
@@ -56,9 +53,7 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
             tree,
             x: sp.point(),
             n: sp.bsdf.ng,
-            memo: TreeMemo {
-                slots: RefCell::new(vec![(NodeId::MAX, 0.0); MEMO_SIZE]),
-            },
+            memo: RefCell::new(Pooled::take()),
             bo,
             n_ls: m - n_bo,
             n_bo,
@@ -70,15 +65,9 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
     }
 
     fn tree_importance(&self, id: NodeId) -> f32 {
-        let slot = (id.wrapping_mul(0x9E37_79B1) >> 22) as usize % MEMO_SIZE;
-        if let Some(&(k, v)) = self.memo.slots.borrow().get(slot)
-            && k == id
-        {
-            return v;
-        }
-        let v = self.tree.importance(id, self.x, self.n);
-        self.memo.slots.borrow_mut()[slot] = (id, v);
-        v
+        self.memo
+            .borrow_mut()
+            .get_or(id, |id| self.tree.importance(id, self.x, self.n))
     }
 
     /// LS selection probability of `light` (a single descent under the tree importance).
