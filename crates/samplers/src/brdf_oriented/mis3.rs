@@ -7,26 +7,23 @@ use super::allocation::{
 use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
 use super::technique::BoState;
+use super::three_techniques::{PointTechniques, Taken};
+pub use super::three_techniques::{TECHNIQUE_BO, TECHNIQUE_BSDF, TECHNIQUE_LS};
 use super::{BoConfig, LobePivot};
-use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
-use crate::light_strategy::sample_pick;
 use crate::mis::power_heuristic;
 use crate::point_sets::{lattice_1d, lattice_sum_variance, r3_point};
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
-use brdf_integrals::CapIntegral;
+use brdf_integrals::{CapIntegral, LobeIntegral};
+use light_tree::LightTree;
+use render_core::Vec3;
 use render_core::colour::luminance;
 use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
-use render_core::{Vec2, Vec3};
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, Ordering};
-
-pub const TECHNIQUE_LS: usize = 0;
-pub const TECHNIQUE_BO: usize = 1;
-pub const TECHNIQUE_BSDF: usize = 2;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mis3Mode {
@@ -74,17 +71,6 @@ crate::scratch_pool!(Mis3Scratch, |s| {
     s.picks.clear();
     s.bo_terms.clear();
 });
-
-/// A sample with a non-zero unweighted contribution: technique, f·L (shadowed), and the densities
-/// of the three techniques at its light point.
-#[derive(Clone, Copy, Debug)]
-struct Taken {
-    tech: usize,
-    /// The sample's index among its technique's samples at this shading point.
-    index: u32,
-    f: Vec3,
-    p: [f32; 3],
-}
 
 impl<C: CapIntegral> Mis3<C>
 where
@@ -222,342 +208,339 @@ where
         let Some(tree) = self.ls.tree.as_ref() else {
             return Vec3::ZERO;
         };
-        let x = sp.point();
-        let fresh = !self.config.reproduce;
-
         if self.mode == Mis3Mode::BoOnly {
-            let Some(bo) = self.bo_state(sp) else {
-                return Vec3::ZERO;
-            };
-            ctx.counters.technique_samples[0] += 1;
-            ctx.counters
-                .record_selection(!sp.bsdf.is_pure_diffuse(), 0, bo.cut().cut.len(), 1);
-            let Some((light, p_sel)) = bo.select(tree, rng, fresh) else {
-                return Vec3::ZERO;
-            };
-            let Some(s) = bo.sample_point(&scene.lights[light], rng) else {
-                return Vec3::ZERO;
-            };
-            let p = p_sel * s.pdf;
-            if !(p > 0.0) {
-                return Vec3::ZERO;
-            }
-            return sp.shade(scene, &s, ctx.counters) / p;
+            return self.estimate_bo_only(scene, sp, tree, rng, ctx);
         }
-
-        let bo = if sp.bsdf.is_pure_diffuse() {
-            None
-        } else {
-            self.bo_state(sp)
-        };
-        // At a glossy point BO and BRDF sampling cover the lobe and LS is the defensive
-        // technique: by default one descent from the root, not the E&K cut's one light per
-        // cluster (README, "one LS descent at glossy points").
-        let ls_state = if bo.is_some() && self.config.single_ls_at_glossy {
-            self.ls.prepare_capped(sp, 1)
-        } else {
-            self.ls.prepare(scene, sp)
-        };
-
-        // Densities of the three techniques at a light point (solid angle; delta lights use
-        // the discrete selection probabilities and no BRDF density).
-        // `own` is the sampling technique, whose density the caller already has.
-        let densities =
-            |light: usize, point: Vec3, normal: Vec3, wi: Vec3, delta: bool, own: usize| {
-                let l = &scene.lights[light];
-                let p_ls = if own == TECHNIQUE_LS {
-                    0.0
-                } else {
-                    let p_pt = if delta { 1.0 } else { l.pdf(x, point, normal) };
-                    self.ls.pmf(&ls_state, sp, light as u32) * p_pt
-                };
-                let p_bo = match &bo {
-                    Some(b) if own != TECHNIQUE_BO || cfg!(debug_assertions) => {
-                        b.selection_pmf(tree, light) * b.point_pdf(l, point, normal, wi)
-                    }
-                    _ => 0.0,
-                };
-                let p_bsdf = if delta || own == TECHNIQUE_BSDF {
-                    0.0
-                } else {
-                    sp.bsdf.pdf(sp.wo, wi)
-                };
-                [p_ls, p_bo, p_bsdf]
-            };
+        let point = self.cuts(scene, sp, tree);
         let mut scratch = Pooled::<Mis3Scratch>::take();
         let Mis3Scratch {
             taken,
             picks,
             bo_terms,
         } = &mut *scratch;
-
-        // LS: one light per cluster of the E&K cut (a splitting technique counts as one sample).
-        self.ls.pick(&ls_state, sp, rng, picks);
-        for &(light, pmf) in picks.iter() {
-            ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
-            let Some((s, p_ls, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters) else {
-                continue;
-            };
-            let mut p = densities(
-                light as usize,
-                s.point,
-                s.normal,
-                s.wi,
-                s.is_delta,
-                TECHNIQUE_LS,
-            );
-            debug_assert!(
-                {
-                    let replay = self.ls.pmf(&ls_state, sp, light)
-                        * scene.lights[light as usize].pdf(x, s.point, s.normal);
-                    s.is_delta || (replay - p_ls).abs() <= 1e-3 * p_ls
-                },
-                "LS pdf at sampling vs replay"
-            );
-            p[TECHNIQUE_LS] = p_ls;
-            taken.push(Taken {
-                tech: TECHNIQUE_LS,
-                index: 0,
-                f,
-                p,
-            });
-        }
-
-        // One BO sample.
-        // `u_cluster`: the cluster choice's number when the caller stratifies them.
-        let bo_sample = |taken: &mut Vec<Taken>,
-                         rng: &mut SampleStream,
-                         ctx: &mut SampleContext,
-                         index: u32,
-                         u_cluster: Option<f32>| {
-            let Some(b) = bo.as_ref() else { return };
-            ctx.counters.technique_samples[TECHNIQUE_BO] += 1;
-            let picked = match u_cluster {
-                Some(u) => b.select_with(tree, u, rng, fresh),
-                None => b.select(tree, rng, fresh),
-            };
-            let Some((light, p_sel)) = picked else {
-                return;
-            };
-            let Some(s) = b.sample_point(&scene.lights[light], rng) else {
-                return;
-            };
-            let p_bo = p_sel * s.pdf;
-            if !(p_bo > 0.0) {
-                return;
-            }
-            let f = sp.shade(scene, &s, ctx.counters);
-            if f == Vec3::ZERO {
-                return;
-            }
-            let mut p = densities(light, s.point, s.normal, s.wi, s.is_delta, TECHNIQUE_BO);
-            debug_assert!(
-                (p[TECHNIQUE_BO] - p_bo).abs() <= 1e-3 * p_bo,
-                "BO pdf at sampling {p_bo} vs replay {}",
-                p[TECHNIQUE_BO]
-            );
-            p[TECHNIQUE_BO] = p_bo;
-            taken.push(Taken {
-                tech: TECHNIQUE_BO,
-                index,
-                f,
-                p,
-            });
-        };
-        // One BRDF sample; returns whether it reached an emitter.
-        // `u`: the lobe choice's and the direction's numbers when the caller stratifies them.
-        let bsdf_sample = |taken: &mut Vec<Taken>,
-                           rng: &mut SampleStream,
-                           ctx: &mut SampleContext,
-                           u: Option<(f32, Vec2)>| {
-            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
-            let drawn = match u {
-                Some((u_lobe, u_dir)) => sample_bsdf_at(scene, sp, u_lobe, u_dir, ctx.counters),
-                None => sample_bsdf(scene, sp, rng, ctx.counters),
-            };
-            let Some(b) = drawn else {
-                return false;
-            };
-            if !b.found_light() {
-                return false;
-            }
-            let mut p = densities(
-                b.light as usize,
-                b.point,
-                b.normal,
-                b.wi,
-                false,
-                TECHNIQUE_BSDF,
-            );
-            p[TECHNIQUE_BSDF] = b.pdf;
-            taken.push(Taken {
-                tech: TECHNIQUE_BSDF,
-                index: 0,
-                f: b.f_cos * b.radiance,
-                p,
-            });
-            true
-        };
-
-        let (n_bo, n_brdf, n_extra, stratified) = match (&bo, self.mode) {
-            (None, _) => {
-                bsdf_sample(taken, rng, ctx, None);
-                (0, 1, 0, false)
-            }
-            (Some(_), Mis3Mode::Equal) => {
-                bo_sample(taken, rng, ctx, 0, None);
-                bsdf_sample(taken, rng, ctx, None);
-                (1, 1, 0, false)
-            }
-            (Some(b), _) => {
-                // Heuristic 1's UB, optionally times the glossy lobe's weight (Ks·F), as the
-                // fidelity issue asks; off by default until it wins at equal time.
-                let ub = if self.config.weighted_ub {
-                    b.cut().upper_bound() * b.rec.ks.min(1.0)
-                } else {
-                    b.cut().upper_bound()
-                };
-                let n_max = if self.learns_n_max() {
-                    self.n_max_now()
-                } else {
-                    self.config.n_max as f32
-                };
-                let n = total_brdf_aware(ub, n_max, self.config.adaptive_total);
-                if self.config.reproduce {
-                    // The authors' in-sample loop (biased: the outcomes pick the counts), with
-                    // their one random number rescaled at every step.
-                    let mut c = InSampleCounters::new(self.config.lambda);
-                    bo_sample(taken, rng, ctx, 0, None);
-                    c.record(bsdf_sample(taken, rng, ctx, None));
-                    let (mut n_bo, mut n_brdf) = (1, 1);
-                    let mut u = rng.next_f32();
-                    for _ in 0..n {
-                        let p = if self.config.adaptive_split {
-                            c.p_bo()
-                        } else {
-                            0.5
-                        };
-                        if u < p {
-                            bo_sample(taken, rng, ctx, 0, None);
-                            n_bo += 1;
-                            u /= p;
-                        } else {
-                            c.record(bsdf_sample(taken, rng, ctx, None));
-                            n_brdf += 1;
-                            u = (u - p) / (1.0 - p);
-                        }
-                    }
-                    (n_bo, n_brdf, n, false)
-                } else {
-                    // Counts fixed before drawing, from earlier samples of this pixel.
-                    let (n_bo, n_brdf) = fixed_counts(n, self.planned_p_bo(ctx));
-                    // Stratified by default: one random shift per technique and shading point
-                    // (see `stratified`); each sample stays uniform on its own, so the fixed-count
-                    // MIS estimator stays unbiased.
-                    let strata = self
-                        .config
-                        .stratified
-                        .then(|| (rng.next_f32(), rng.next_f32(), rng.next_2d()));
-                    for i in 0..n_bo {
-                        let u = strata.map(|(shift, ..)| lattice_1d(shift, i, n_bo));
-                        bo_sample(taken, rng, ctx, i, u);
-                    }
-                    let mut hits = 0u32;
-                    for i in 0..n_brdf {
-                        let u = strata.map(|(_, lobe, dir)| r3_point(lobe, dir, i));
-                        hits += bsdf_sample(taken, rng, ctx, u) as u32;
-                    }
-                    ctx.pixel_memory[SLOT_HITS] += hits as f32;
-                    ctx.pixel_memory[SLOT_MISSES] += (n_brdf - hits) as f32;
-                    (n_bo, n_brdf, n, strata.is_some())
-                }
-            }
-        };
-        ctx.counters.record_selection(
-            bo.is_some(),
-            self.ls.clusters(&ls_state),
-            bo.as_ref().map_or(0, |b| b.cut().cut.len()),
-            (n_bo + n_brdf) as usize,
-        );
-        ctx.aux[0] = n_extra as f32;
-        ctx.aux[1] = if n_bo + n_brdf > 0 {
-            n_bo as f32 / (n_bo + n_brdf) as f32
-        } else {
-            0.0
-        };
-
-        let counts = [1.0f32, n_bo as f32, n_brdf as f32];
-        let mut l = Vec3::ZERO;
+        point.ls_samples(taken, picks, rng, ctx);
+        let counts = self.brdf_aware_samples(&point, taken, rng, ctx);
+        record_counts(&point, &counts, ctx);
         let learns = self.learns_n_max();
-        // Per BRDF-aware technique: Σz and Σz² of the luminance z of each sample's term.
-        let mut moments = [[0.0f32; 2]; 3];
-        // Stratified BO terms, in stratum order, for their variance (below).
-        let stratified_bo = learns && stratified;
+        // Stratified BO terms are kept in stratum order for their variance (`record_efficiency`).
+        let stratified_bo = learns && counts.stratified;
         if stratified_bo {
-            bo_terms.resize(n_bo as usize, 0.0);
+            bo_terms.resize(counts.n_bo as usize, 0.0);
         }
-        for t in taken.iter() {
-            let techniques = [
-                (counts[0], t.p[0]),
-                (counts[1], t.p[1]),
-                (counts[2], t.p[2]),
-            ];
-            let w = power_heuristic(t.tech, &techniques);
-            debug_assert!(
-                {
-                    let sum: f32 = (0..3).map(|k| power_heuristic(k, &techniques)).sum();
-                    (sum - 1.0).abs() < 1e-4
-                },
-                "MIS weights do not sum to one: {techniques:?}"
-            );
-            let np = counts[t.tech] * t.p[t.tech];
-            if np > 0.0 && w > 0.0 {
-                let term = t.f * (w / np);
-                l += term;
-                if learns {
-                    let z = luminance(term);
-                    moments[t.tech][0] += z;
-                    moments[t.tech][1] += z * z;
-                    if stratified_bo && t.tech == TECHNIQUE_BO {
-                        bo_terms[t.index as usize] = z;
-                    }
-                }
-            }
-        }
+        let (l, moments) = mis_weighted_sum(taken, &counts, learns, stratified_bo, bo_terms);
         if learns {
-            // In units of one BRDF-aware sample (a ray, a descent, the other techniques'
-            // densities), the rest costs about two for the camera ray and shading, one per LS
-            // cluster and a quarter per BO cluster (measured: ARCHITECTURE.md, "N_max chosen
-            // by variance × cost").
-            let ls_clusters = self.ls.clusters(&ls_state) as f32;
-            let bo_clusters = bo.as_ref().map_or(0, |b| b.cut().cut.len()) as f32;
-            let rest_cost = 2.0 + ls_clusters + 0.25 * bo_clusters;
-            let glossy = bo.as_ref().map(|b| {
-                // The variance the BRDF-aware samples added: n_t times the spread of one term
-                // of technique t (its samples without contribution count as zeros). Stratified
-                // BO samples: collapsed strata (`lattice_sum_variance`), as the spread over all
-                // strata would count the differences between them; the R3 set of BRDF samples
-                // has no such neighbours, and keeps the spread (an overestimate).
-                let mut within = 0.0;
-                if stratified_bo {
-                    within += lattice_sum_variance(bo_terms);
-                }
-                for (t, n_t) in [(TECHNIQUE_BO, n_bo), (TECHNIQUE_BSDF, n_brdf)] {
-                    if t == TECHNIQUE_BO && stratified_bo {
-                        continue;
-                    }
-                    let [sum, sum_sq] = moments[t];
-                    let var = if n_t >= 2 {
-                        ((sum_sq - sum * sum / n_t as f32) / (n_t - 1) as f32).max(0.0)
-                    } else {
-                        sum_sq
-                    };
-                    within += n_t as f32 * var;
-                }
-                (within, n_bo + n_brdf, b.cut().upper_bound())
-            });
-            EfficiencyTally::record(&mut ctx.pixel_memory[..], luminance(l), rest_cost, glossy);
+            record_efficiency(&point, &counts, l, &moments, stratified_bo, bo_terms, ctx);
         }
         l
     }
+}
+
+/// How many samples each BRDF-aware technique took at a shading point.
+struct Counts {
+    n_bo: u32,
+    n_brdf: u32,
+    /// Heuristic 1's N, the samples beyond the forced ones (the `n_brdf_aware` channel).
+    n_extra: u32,
+    /// Whether the samples were stratified sets (`point_sets`).
+    stratified: bool,
+}
+
+impl<C: CapIntegral> Mis3<C>
+where
+    C::Lobe: LobePivot + LobeDensity,
+{
+    /// `brdf-oriented`: one BO sample, no MIS.
+    fn estimate_bo_only(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        tree: &LightTree,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let Some(bo) = self.bo_state(sp) else {
+            return Vec3::ZERO;
+        };
+        ctx.counters.technique_samples[0] += 1;
+        ctx.counters
+            .record_selection(!sp.bsdf.is_pure_diffuse(), 0, bo.cut().cut.len(), 1);
+        let Some((light, p_sel)) = bo.select(tree, rng, !self.config.reproduce) else {
+            return Vec3::ZERO;
+        };
+        let Some(s) = bo.sample_point(&scene.lights[light], rng) else {
+            return Vec3::ZERO;
+        };
+        let p = p_sel * s.pdf;
+        if !(p > 0.0) {
+            return Vec3::ZERO;
+        }
+        sp.shade(scene, &s, ctx.counters) / p
+    }
+
+    /// Step 1, the cuts: the BO cut at a glossy point, and the LS cut. At a glossy point BO and
+    /// BRDF sampling cover the lobe and LS is the defensive technique: by default one descent
+    /// from the root there, not the E&K cut's one light per cluster (`single_ls_at_glossy`).
+    fn cuts<'a>(
+        &'a self,
+        scene: &'a Scene,
+        sp: &'a ShadingPoint,
+        tree: &'a LightTree,
+    ) -> PointTechniques<'a, C::Lobe> {
+        let bo = if sp.bsdf.is_pure_diffuse() {
+            None
+        } else {
+            self.bo_state(sp)
+        };
+        let ls_state = if bo.is_some() && self.config.single_ls_at_glossy {
+            self.ls.prepare_capped(sp, 1)
+        } else {
+            self.ls.prepare(scene, sp)
+        };
+        PointTechniques {
+            scene,
+            sp,
+            tree,
+            ls: &self.ls,
+            ls_state,
+            bo,
+            fresh: !self.config.reproduce,
+        }
+    }
+
+    /// Steps 2 and 3, allocation and the BRDF-aware samples: one BRDF sample at a diffuse
+    /// point, one of each under `mis3-equal`, otherwise heuristic 1's N split by heuristic 2.
+    fn brdf_aware_samples(
+        &self,
+        point: &PointTechniques<C::Lobe>,
+        taken: &mut Vec<Taken>,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Counts {
+        let counts = |n_bo, n_brdf| Counts {
+            n_bo,
+            n_brdf,
+            n_extra: 0,
+            stratified: false,
+        };
+        match (&point.bo, self.mode) {
+            (None, _) => {
+                point.bsdf_sample(taken, rng, ctx, None);
+                counts(0, 1)
+            }
+            (Some(_), Mis3Mode::Equal) => {
+                point.bo_sample(taken, rng, ctx, 0, None);
+                point.bsdf_sample(taken, rng, ctx, None);
+                counts(1, 1)
+            }
+            (Some(b), _) => {
+                let n = self.total_brdf_aware(b);
+                if self.config.reproduce {
+                    self.in_sample_allocation(point, n, taken, rng, ctx)
+                } else {
+                    self.fixed_allocation(point, n, taken, rng, ctx)
+                }
+            }
+        }
+    }
+
+    /// Heuristic 1: N = floor(N_max·UB), UB optionally times the glossy lobe's weight (Ks·F;
+    /// off by default until it wins at equal time), N_max learnt per pass or the constant.
+    fn total_brdf_aware(&self, b: &BoState<C::Lobe>) -> u32 {
+        let ub = if self.config.weighted_ub {
+            b.cut().upper_bound() * b.rec.ks.min(1.0)
+        } else {
+            b.cut().upper_bound()
+        };
+        let n_max = if self.learns_n_max() {
+            self.n_max_now()
+        } else {
+            self.config.n_max as f32
+        };
+        total_brdf_aware(ub, n_max, self.config.adaptive_total)
+    }
+
+    /// The authors' in-sample loop (`reproduce`; biased: the outcomes pick the counts), with
+    /// their one random number rescaled at every step.
+    fn in_sample_allocation(
+        &self,
+        point: &PointTechniques<C::Lobe>,
+        n: u32,
+        taken: &mut Vec<Taken>,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Counts {
+        let mut c = InSampleCounters::new(self.config.lambda);
+        point.bo_sample(taken, rng, ctx, 0, None);
+        c.record(point.bsdf_sample(taken, rng, ctx, None));
+        let (mut n_bo, mut n_brdf) = (1, 1);
+        let mut u = rng.next_f32();
+        for _ in 0..n {
+            let p = if self.config.adaptive_split {
+                c.p_bo()
+            } else {
+                0.5
+            };
+            if u < p {
+                point.bo_sample(taken, rng, ctx, 0, None);
+                n_bo += 1;
+                u /= p;
+            } else {
+                c.record(point.bsdf_sample(taken, rng, ctx, None));
+                n_brdf += 1;
+                u = (u - p) / (1.0 - p);
+            }
+        }
+        Counts {
+            n_bo,
+            n_brdf,
+            n_extra: n,
+            stratified: false,
+        }
+    }
+
+    /// Our default: counts fixed before drawing, from earlier samples of this pixel, then the
+    /// samples, stratified by default (one random shift per technique and shading point; each
+    /// sample stays uniform on its own, so the fixed-count MIS estimator stays unbiased); the
+    /// BRDF samples' hits and misses go to the pixel's tallies for its next samples.
+    fn fixed_allocation(
+        &self,
+        point: &PointTechniques<C::Lobe>,
+        n: u32,
+        taken: &mut Vec<Taken>,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Counts {
+        let (n_bo, n_brdf) = fixed_counts(n, self.planned_p_bo(ctx));
+        let strata = self
+            .config
+            .stratified
+            .then(|| (rng.next_f32(), rng.next_f32(), rng.next_2d()));
+        for i in 0..n_bo {
+            let u = strata.map(|(shift, ..)| lattice_1d(shift, i, n_bo));
+            point.bo_sample(taken, rng, ctx, i, u);
+        }
+        let mut hits = 0u32;
+        for i in 0..n_brdf {
+            let u = strata.map(|(_, lobe, dir)| r3_point(lobe, dir, i));
+            hits += point.bsdf_sample(taken, rng, ctx, u) as u32;
+        }
+        ctx.pixel_memory[SLOT_HITS] += hits as f32;
+        ctx.pixel_memory[SLOT_MISSES] += (n_brdf - hits) as f32;
+        Counts {
+            n_bo,
+            n_brdf,
+            n_extra: n,
+            stratified: strata.is_some(),
+        }
+    }
+}
+
+/// The cut sizes and counts for the render's statistics, and the two diagnostic channels.
+fn record_counts<L: LobeIntegral + LobeDensity>(
+    point: &PointTechniques<L>,
+    counts: &Counts,
+    ctx: &mut SampleContext,
+) {
+    let (ls_clusters, bo_clusters) = point.cluster_counts();
+    let (n_bo, n_brdf) = (counts.n_bo, counts.n_brdf);
+    ctx.counters.record_selection(
+        point.bo.is_some(),
+        ls_clusters,
+        bo_clusters,
+        (n_bo + n_brdf) as usize,
+    );
+    ctx.aux[0] = counts.n_extra as f32;
+    ctx.aux[1] = if n_bo + n_brdf > 0 {
+        n_bo as f32 / (n_bo + n_brdf) as f32
+    } else {
+        0.0
+    };
+}
+
+/// Step 4, the weights: the power heuristic with counts (n_LS = 1, n_BO, n_BRDF) over every
+/// sample taken. With `learns`, also Σz and Σz² per technique of the luminance z of each
+/// sample's term, and (`stratified_bo`) the BO terms in stratum order.
+fn mis_weighted_sum(
+    taken: &[Taken],
+    counts: &Counts,
+    learns: bool,
+    stratified_bo: bool,
+    bo_terms: &mut [f32],
+) -> (Vec3, [[f32; 2]; 3]) {
+    let counts = [1.0f32, counts.n_bo as f32, counts.n_brdf as f32];
+    let mut l = Vec3::ZERO;
+    let mut moments = [[0.0f32; 2]; 3];
+    for t in taken {
+        let techniques = [
+            (counts[0], t.p[0]),
+            (counts[1], t.p[1]),
+            (counts[2], t.p[2]),
+        ];
+        let w = power_heuristic(t.tech, &techniques);
+        debug_assert!(
+            {
+                let sum: f32 = (0..3).map(|k| power_heuristic(k, &techniques)).sum();
+                (sum - 1.0).abs() < 1e-4
+            },
+            "MIS weights do not sum to one: {techniques:?}"
+        );
+        let np = counts[t.tech] * t.p[t.tech];
+        if np > 0.0 && w > 0.0 {
+            let term = t.f * (w / np);
+            l += term;
+            if learns {
+                let z = luminance(term);
+                moments[t.tech][0] += z;
+                moments[t.tech][1] += z * z;
+                if stratified_bo && t.tech == TECHNIQUE_BO {
+                    bo_terms[t.index as usize] = z;
+                }
+            }
+        }
+    }
+    (l, moments)
+}
+
+/// Step 5, learning N_max: the sample's luminance, the rest of its cost and, at a glossy
+/// point, the variance its BRDF-aware samples added, into the pixel's efficiency tally.
+fn record_efficiency<L: LobeIntegral + LobeDensity>(
+    point: &PointTechniques<L>,
+    counts: &Counts,
+    l: Vec3,
+    moments: &[[f32; 2]; 3],
+    stratified_bo: bool,
+    bo_terms: &[f32],
+    ctx: &mut SampleContext,
+) {
+    let (n_bo, n_brdf) = (counts.n_bo, counts.n_brdf);
+    // In units of one BRDF-aware sample (a ray, a descent, the other techniques' densities),
+    // the rest costs about two for the camera ray and shading, one per LS cluster and a
+    // quarter per BO cluster (measured: ARCHITECTURE.md, "N_max chosen by variance × cost").
+    let (ls_clusters, bo_clusters) = point.cluster_counts();
+    let rest_cost = 2.0 + ls_clusters as f32 + 0.25 * bo_clusters as f32;
+    let glossy = point.bo.as_ref().map(|b| {
+        // The variance the BRDF-aware samples added: n_t times the spread of one term of
+        // technique t (its samples without contribution count as zeros). Stratified BO
+        // samples: collapsed strata (`lattice_sum_variance`), as the spread over all strata
+        // would count the differences between them; the R3 set of BRDF samples has no such
+        // neighbours, and keeps the spread (an overestimate).
+        let mut within = 0.0;
+        if stratified_bo {
+            within += lattice_sum_variance(bo_terms);
+        }
+        for (t, n_t) in [(TECHNIQUE_BO, n_bo), (TECHNIQUE_BSDF, n_brdf)] {
+            if t == TECHNIQUE_BO && stratified_bo {
+                continue;
+            }
+            let [sum, sum_sq] = moments[t];
+            let var = if n_t >= 2 {
+                ((sum_sq - sum * sum / n_t as f32) / (n_t - 1) as f32).max(0.0)
+            } else {
+                sum_sq
+            };
+            within += n_t as f32 * var;
+        }
+        (within, n_bo + n_brdf, b.cut().upper_bound())
+    });
+    EfficiencyTally::record(&mut ctx.pixel_memory[..], luminance(l), rest_cost, glossy);
 }

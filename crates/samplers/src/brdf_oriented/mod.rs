@@ -14,6 +14,7 @@ pub mod importance;
 pub mod mis3;
 pub mod pivot_sphere;
 pub mod technique;
+pub mod three_techniques;
 
 use brdf_integrals::{LtcLobe, SptdLobe};
 use render_core::Vec3;
