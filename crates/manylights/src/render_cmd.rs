@@ -4,6 +4,7 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use render_core::output::{write_exr, write_json, write_mask_png, write_png};
 use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
+use render_core::sampler::Sampler;
 use samplers::StrategyOptions;
 use samplers::brdf_oriented::BrdfIntegral;
 use std::path::{Path, PathBuf};
@@ -20,6 +21,10 @@ pub struct RenderArgs {
     pub spp: Option<u32>,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
+    /// Where the samples' numbers come from: `independent` numbers per dimension, or `sobol`,
+    /// shuffled Owen-scrambled (0,2)-sequences in consecutive dimension pairs.
+    #[arg(long, default_value_t = Sampler::Independent, value_parser = sampler_parser())]
+    pub sampler: Sampler,
     #[arg(long)]
     pub width: Option<u32>,
     #[arg(long)]
@@ -122,6 +127,13 @@ pub enum BudgetClockArg {
 fn brdf_integral_parser() -> impl clap::builder::TypedValueParser<Value = BrdfIntegral> {
     use clap::builder::{PossibleValuesParser, TypedValueParser};
     PossibleValuesParser::new(BrdfIntegral::ALL.map(BrdfIntegral::name)).try_map(|s| s.parse())
+}
+
+/// `--sampler`: the names of [`Sampler`], listed in `--help`.
+fn sampler_parser() -> impl clap::builder::TypedValueParser<Value = Sampler> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(Sampler::ALL.map(Sampler::name))
+        .map(|s| Sampler::from_name(&s).expect("a listed name"))
 }
 
 impl MethodArgs {
@@ -251,6 +263,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }),
         threads: args.threads,
         camera: camera.clone(),
+        sampler: args.sampler,
     };
     let bar = if args.quiet {
         ProgressBar::hidden()
@@ -324,6 +337,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "time_budget_s": args.time_budget,
         "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
         "seed": args.seed,
+        "sampler": args.sampler.name(),
         "width": width,
         "height": height,
         "camera": camera,

@@ -52,6 +52,7 @@ fn render_case(scene: &Scene, strategy: &str, opts: &StrategyOptions) -> u64 {
         time_budget: None,
         threads: Some(2),
         camera: scene.camera(None).unwrap(),
+        sampler: Default::default(),
     };
     hash_render(&render(scene, s.as_ref(), &settings, &|_, _| {}).unwrap())
 }

@@ -22,6 +22,7 @@ pub mod metrics;
 pub mod output;
 pub mod render;
 pub mod rng;
+pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod stats;

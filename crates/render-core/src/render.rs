@@ -12,6 +12,7 @@ use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::estimator::{DirectLighting, MAX_AUX, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use crate::rng::SampleStream;
+use crate::sampler::Sampler;
 use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
 use crate::stats::Counters;
 use glam::{Vec2, Vec3};
@@ -37,6 +38,8 @@ pub struct RenderSettings {
     /// Worker threads (`None` = all cores).
     pub threads: Option<usize>,
     pub camera: Camera,
+    /// Where the samples' numbers come from.
+    pub sampler: Sampler,
 }
 
 /// A render-time limit, checked before each work unit.
@@ -193,7 +196,12 @@ impl PassJob<'_> {
         for (i, px) in unit.iter_mut().enumerate() {
             let index = u * UNIT_PIXELS + i;
             let (x, y) = (index % w, index / w);
-            let mut rng = SampleStream::new(self.settings.seed, index as u64, sample_index);
+            let mut rng = SampleStream::with_sampler(
+                self.settings.sampler,
+                self.settings.seed,
+                index as u64,
+                sample_index,
+            );
             let jitter = rng.next_2d();
             let film = Vec2::new(
                 (x as f32 + jitter.x) / w as f32,
@@ -546,6 +554,16 @@ mod tests {
     }
 
     fn run(scene: &Scene, spp: Option<u32>, budget: Option<f64>, threads: usize) -> RenderResult {
+        run_with(scene, spp, budget, threads, Sampler::Independent)
+    }
+
+    fn run_with(
+        scene: &Scene,
+        spp: Option<u32>,
+        budget: Option<f64>,
+        threads: usize,
+        sampler: Sampler,
+    ) -> RenderResult {
         let settings = RenderSettings {
             width: 64,
             height: 40,
@@ -557,6 +575,7 @@ mod tests {
             }),
             threads: Some(threads),
             camera: scene.camera(None).unwrap(),
+            sampler,
         };
         render(scene, &OneLight, &settings, &|_, _| {}).unwrap()
     }
@@ -564,12 +583,17 @@ mod tests {
     #[test]
     fn images_are_identical_for_any_thread_count() {
         let scene = test_scene();
-        let a = run(&scene, Some(3), None, 1);
-        let b = run(&scene, Some(3), None, 3);
-        assert_eq!((a.spp, a.partial_pixels, b.spp), (3, 0, 3));
-        assert_eq!(a.pixels, b.pixels);
-        assert_eq!(a.variance_of_mean, b.variance_of_mean);
-        assert_eq!(a.counters, b.counters);
+        let mut images = Vec::new();
+        for sampler in Sampler::ALL {
+            let a = run_with(&scene, Some(3), None, 1, sampler);
+            let b = run_with(&scene, Some(3), None, 3, sampler);
+            assert_eq!((a.spp, a.partial_pixels, b.spp), (3, 0, 3));
+            assert_eq!(a.pixels, b.pixels, "{sampler}");
+            assert_eq!(a.variance_of_mean, b.variance_of_mean, "{sampler}");
+            assert_eq!(a.counters, b.counters, "{sampler}");
+            images.push(a.pixels);
+        }
+        assert_ne!(images[0], images[1], "the samplers draw different numbers");
     }
 
     /// A budget spent at once stops after one work unit, inside the first pass: the render

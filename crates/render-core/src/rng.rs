@@ -1,16 +1,22 @@
 //! Counter-based random numbers: the value of a dimension depends only on
 //! (seed, pixel, sample index, dimension), never on thread scheduling, so an image is
-//! bit-identical whatever the thread count.
+//! bit-identical whatever the thread count. Which value that is, the [`Sampler`] decides.
+use crate::sampler::{Sampler, sobol_value};
 
 /// The stream of uniform numbers of one pixel sample.
 #[derive(Clone, Debug)]
 pub struct SampleStream {
     key: u64,
     dim: u32,
+    sampler: Sampler,
+    /// The sample index within its pixel (`sobol` only).
+    index: u32,
+    /// A hash of (seed, pixel) (`sobol` only).
+    pixel_key: u64,
 }
 
 #[inline]
-fn mix64(mut z: u64) -> u64 {
+pub(crate) fn mix64(mut z: u64) -> u64 {
     // splitmix64 finaliser: a bijective avalanche mix.
     z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
@@ -18,12 +24,32 @@ fn mix64(mut z: u64) -> u64 {
 }
 
 impl SampleStream {
+    /// The independent sampler's stream of sample `sample_index` of pixel `pixel`.
     pub fn new(seed: u64, pixel: u64, sample_index: u64) -> SampleStream {
-        let key = mix64(
-            mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel)
-                ^ sample_index.wrapping_mul(0xd1b5_4a32_d192_ed03),
-        );
-        SampleStream { key, dim: 0 }
+        SampleStream::with_sampler(Sampler::Independent, seed, pixel, sample_index)
+    }
+
+    /// The stream of sample `sample_index` of pixel `pixel` under `sampler`.
+    pub fn with_sampler(
+        sampler: Sampler,
+        seed: u64,
+        pixel: u64,
+        sample_index: u64,
+    ) -> SampleStream {
+        let pixel_key = mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel);
+        let key = mix64(pixel_key ^ sample_index.wrapping_mul(0xd1b5_4a32_d192_ed03));
+        SampleStream {
+            key,
+            dim: 0,
+            sampler,
+            index: sample_index as u32,
+            pixel_key,
+        }
+    }
+
+    /// The sampler the numbers come from.
+    pub fn sampler(&self) -> Sampler {
+        self.sampler
     }
 
     /// A uniform number in [0, 1).
@@ -38,12 +64,24 @@ impl SampleStream {
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
         let bits = mix64(self.key ^ (self.dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+        let bits = match self.sampler {
+            Sampler::Independent => bits,
+            // The sequence's 32 bits on top, independent ones below them.
+            Sampler::Sobol => {
+                ((sobol_value(self.pixel_key, self.index, self.dim) as u64) << 32)
+                    | (bits & 0xffff_ffff)
+            }
+        };
         self.dim += 1;
         bits
     }
 
     #[inline]
     pub fn next_2d(&mut self) -> glam::Vec2 {
+        // Under `sobol` a 2D draw takes one whole pair of dimensions (2k, 2k + 1).
+        if self.sampler == Sampler::Sobol && self.dim % 2 == 1 {
+            self.dim += 1;
+        }
         let a = self.next_f32();
         glam::Vec2::new(a, self.next_f32())
     }

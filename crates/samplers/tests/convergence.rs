@@ -166,6 +166,7 @@ fn a_strategy_object_renders_the_same_image_twice() {
         time_budget: None,
         threads: Some(2),
         camera,
+        sampler: Default::default(),
     };
     let a = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
     let b = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
@@ -202,6 +203,7 @@ fn bisml_cornell_from_pbrt_agrees_with_its_gltf() {
             time_budget: None,
             threads: Some(2),
             camera,
+            sampler: Default::default(),
         };
         render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
     };

@@ -319,6 +319,7 @@ fn load_and_render(path: &Path, case: u64) -> Result<Outcome, String> {
         time_budget: None,
         threads: Some(1),
         camera,
+        sampler: Default::default(),
     };
     match render_core::render::render(&scene, strategy.as_ref(), &settings, &|_, _| {}) {
         Ok(r) => {

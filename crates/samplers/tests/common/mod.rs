@@ -224,6 +224,7 @@ pub fn render_opts(
         time_budget: None,
         threads: Some(threads),
         camera,
+        sampler: Default::default(),
     };
     render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
 }

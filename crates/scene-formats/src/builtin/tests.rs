@@ -407,6 +407,7 @@ fn every_builtin_renders_a_lit_image() {
             time_budget: None,
             threads: Some(1),
             camera,
+            sampler: Default::default(),
         };
         let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
         // Leave out pixels that see a light directly: the rest is reflected light.
