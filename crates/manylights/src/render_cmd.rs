@@ -2,6 +2,7 @@
 use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+use render_core::filter::PixelFilter;
 use render_core::output::{write_exr, write_json, write_mask_png, write_png};
 use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
@@ -25,6 +26,10 @@ pub struct RenderArgs {
     /// shuffled Owen-scrambled (0,2)-sequences in consecutive dimension pairs.
     #[arg(long, default_value_t = Sampler::Independent, value_parser = sampler_parser())]
     pub sampler: Sampler,
+    /// The pixel filter, `NAME[:RADIUS]`: box (radius 0.5 by default), triangle (2), gaussian
+    /// (1.5, sigma 0.5) or mitchell (2, B = C = 1/3), sampled by filter importance sampling.
+    #[arg(long, default_value = "box", value_parser = PixelFilter::parse)]
+    pub filter: PixelFilter,
     #[arg(long)]
     pub width: Option<u32>,
     #[arg(long)]
@@ -264,6 +269,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         threads: args.threads,
         camera: camera.clone(),
         sampler: args.sampler,
+        filter: args.filter.clone(),
     };
     let bar = if args.quiet {
         ProgressBar::hidden()
@@ -338,6 +344,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
         "seed": args.seed,
         "sampler": args.sampler.name(),
+        "filter": {
+            "name": args.filter.name(),
+            "parameters": args.filter.parameters().into_iter().collect::<std::collections::BTreeMap<_, _>>(),
+        },
         "width": width,
         "height": height,
         "camera": camera,

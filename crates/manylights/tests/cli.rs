@@ -559,3 +559,41 @@ fn pbrt_scenes_info_convert_render_and_errors() {
         "bad.pbrt:2: parameter",
     );
 }
+
+#[test]
+fn sampler_and_filter_are_chosen_and_recorded() {
+    let dir = temp_dir("sampler-filter");
+    let o = render_to(&dir, "s", &["--sampler", "sobol", "--filter", "triangle:1"]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("s.json")).unwrap()).unwrap();
+    assert_eq!(meta["sampler"], "sobol");
+    assert_eq!(meta["filter"]["name"], "triangle");
+    assert_eq!(meta["filter"]["parameters"]["radius"], 1.0);
+    let bad = manylights(&[
+        "render", SCENE, "--spp", "1", "--filter", "lanczos", "--quiet",
+    ]);
+    let err = String::from_utf8_lossy(&bad.stderr);
+    assert!(
+        !bad.status.success() && err.contains("unknown pixel filter"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    let empty = temp_dir("sampler-filter-refused");
+    let out = empty.join("x.exr");
+    assert_clean_failure(
+        &empty,
+        &[
+            "render",
+            SCENE,
+            "--sampler",
+            "stratified",
+            "--time-budget",
+            "0.1",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "stratified sampler",
+    );
+}

@@ -15,6 +15,7 @@ pub mod camera;
 pub mod colour;
 pub mod error;
 pub mod estimator;
+pub mod filter;
 pub mod frame;
 pub mod light;
 pub mod material;

@@ -11,6 +11,7 @@
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::estimator::{DirectLighting, MAX_AUX, PIXEL_MEMORY, SampleContext, ShadingPoint};
+use crate::filter::PixelFilter;
 use crate::rng::SampleStream;
 use crate::sampler::Sampler;
 use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
@@ -40,6 +41,8 @@ pub struct RenderSettings {
     pub camera: Camera,
     /// Where the samples' numbers come from.
     pub sampler: Sampler,
+    /// How camera samples are spread over and weighted within their pixel.
+    pub filter: PixelFilter,
 }
 
 /// A render-time limit, checked before each work unit.
@@ -201,11 +204,12 @@ impl PassJob<'_> {
                 self.settings.seed,
                 index as u64,
                 sample_index,
-            );
-            let jitter = rng.next_2d();
+            )
+            .with_pixel_samples(self.settings.spp.unwrap_or(0));
+            let (offset, weight) = self.settings.filter.sample(rng.next_2d());
             let film = Vec2::new(
-                (x as f32 + jitter.x) / w as f32,
-                (y as f32 + jitter.y) / h as f32,
+                (x as f32 + offset.x) / w as f32,
+                (y as f32 + offset.y) / h as f32,
             );
             let mut ctx = SampleContext {
                 counters: c,
@@ -221,6 +225,8 @@ impl PassJob<'_> {
                 &mut rng,
                 &mut ctx,
             );
+            // Exact for the weight-1 filters (box, triangle).
+            let l = l * weight;
             let aux = ctx.aux;
             // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
             for k in 0..3 {
@@ -316,6 +322,13 @@ pub fn render(
     }
     if settings.spp.is_none() && settings.time_budget.is_none() {
         return Err("give spp, a time budget, or both".into());
+    }
+    if settings.sampler.needs_spp() && settings.spp.is_none() {
+        return Err(format!(
+            "the {} sampler cuts its strata by the sample count: give spp (with a time budget, \
+             the most samples a pixel may take)",
+            settings.sampler
+        ));
     }
     check_memory(
         settings.width,
@@ -576,6 +589,7 @@ mod tests {
             threads: Some(threads),
             camera: scene.camera(None).unwrap(),
             sampler,
+            filter: Default::default(),
         };
         render(scene, &OneLight, &settings, &|_, _| {}).unwrap()
     }

@@ -1,7 +1,7 @@
 //! Counter-based random numbers: the value of a dimension depends only on
 //! (seed, pixel, sample index, dimension), never on thread scheduling, so an image is
 //! bit-identical whatever the thread count. Which value that is, the [`Sampler`] decides.
-use crate::sampler::{Sampler, sobol_value};
+use crate::sampler::{SamplePosition, Sampler};
 
 /// The stream of uniform numbers of one pixel sample.
 #[derive(Clone, Debug)]
@@ -9,10 +9,8 @@ pub struct SampleStream {
     key: u64,
     dim: u32,
     sampler: Sampler,
-    /// The sample index within its pixel (`sobol` only).
-    index: u32,
-    /// A hash of (seed, pixel) (`sobol` only).
-    pixel_key: u64,
+    /// Where the sample sits, for the samplers other than `independent`.
+    at: SamplePosition,
 }
 
 #[inline]
@@ -42,9 +40,19 @@ impl SampleStream {
             key,
             dim: 0,
             sampler,
-            index: sample_index as u32,
-            pixel_key,
+            at: SamplePosition {
+                pixel_key,
+                index: sample_index as u32,
+                pixel_samples: 0,
+            },
         }
+    }
+
+    /// The same stream, told how many samples its pixel will take (the `stratified` sampler
+    /// cuts its strata by it).
+    pub fn with_pixel_samples(mut self, spp: u32) -> SampleStream {
+        self.at.pixel_samples = spp;
+        self
     }
 
     /// The sampler the numbers come from.
@@ -64,22 +72,15 @@ impl SampleStream {
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
         let bits = mix64(self.key ^ (self.dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        let bits = match self.sampler {
-            Sampler::Independent => bits,
-            // The sequence's 32 bits on top, independent ones below them.
-            Sampler::Sobol => {
-                ((sobol_value(self.pixel_key, self.index, self.dim) as u64) << 32)
-                    | (bits & 0xffff_ffff)
-            }
-        };
+        let bits = self.sampler.bits(&self.at, self.dim, bits);
         self.dim += 1;
         bits
     }
 
     #[inline]
     pub fn next_2d(&mut self) -> glam::Vec2 {
-        // Under `sobol` a 2D draw takes one whole pair of dimensions (2k, 2k + 1).
-        if self.sampler == Sampler::Sobol && self.dim % 2 == 1 {
+        // Under a sequence a 2D draw takes one whole pair of dimensions (2k, 2k + 1).
+        if self.sampler.pairs_dimensions() && self.dim % 2 == 1 {
             self.dim += 1;
         }
         let a = self.next_f32();

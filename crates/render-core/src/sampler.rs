@@ -1,20 +1,29 @@
 //! Samplers: where the numbers of a pixel sample come from.
 //!
 //! Every strategy draws its numbers through [`crate::rng::SampleStream`], one dimension at a
-//! time; the sampler decides what the value of (seed, pixel, sample index, dimension) is.
+//! time; the sampler decides what the value of (seed, pixel, sample index, dimension) is. The
+//! dimensions come in pairs (2k, 2k + 1): `next_2d` always takes one whole pair, a 1D draw
+//! takes the next dimension. The film position (the pixel filter's sample) is pair 0; what a
+//! strategy draws after it is in the order its code draws it (ARCHITECTURE.md lists it).
 //!
 //! - `independent`: every value an independent hash (the renderer's original numbers, bit for
 //!   bit).
-//! - `sobol`: the first two Sobol dimensions (a (0,2)-sequence) for each pair of consecutive
-//!   dimensions (2k, 2k+1), the sample index shuffled and each coordinate Owen-scrambled by
-//!   hashes of (seed, pixel, k) (Burley 2020, "Practical hash-based Owen scrambling"; pbrt-v4's
-//!   padded Sobol sampler and Cycles' Sobol–Burley are of this family). The first 2^m samples
-//!   of a pixel form a (0,m,2)-net in every pair, whatever m: passes stay progressive. The
-//!   shuffle decorrelates the pairs from each other; pixels are scrambled independently (no
-//!   blue-noise ordering across pixels).
+//! - `stratified`: jittered strata per pair, pbrt's `stratified` sampler: the pair's square cut
+//!   into nx × ny ≥ spp cells (nx = ⌊√spp⌋), sample i of a pixel in cell π(i) of a permutation
+//!   hashed from (seed, pixel, pair), jittered inside it. Needs the render's spp.
+//! - `sobol`: the first two Sobol dimensions (a (0,2)-sequence) for each pair, the sample index
+//!   shuffled and each coordinate Owen-scrambled by hashes of (seed, pixel, pair) (Burley 2020,
+//!   "Practical hash-based Owen scrambling"; pbrt-v4's padded Sobol sampler and Cycles'
+//!   Sobol–Burley are of this family). The first 2^m samples of a pixel form a (0,m,2)-net in
+//!   every pair, whatever m: passes stay progressive. Pixels are scrambled independently (no
+//!   blue-noise ordering across pixels, as pbrt-v4's ZSobol has).
+//! - `lowdiscrepancy`: pbrt-v3's (0,2)-sequence sampler, the one the authors' scene names: the
+//!   same shuffled pairs, randomised by a random-digit (XOR) scramble per pixel and dimension
+//!   instead of Owen's. pbrt-v3 draws a fixed power-of-two set per pixel and shuffles it;
+//!   ours is the progressive equivalent (every power-of-two prefix is a net).
 //!
-//! Every value is uniform on its own under either sampler, so each sample is unbiased. With
-//! `sobol` the samples of one pixel are stratified against each other, and a strategy that
+//! Every value is uniform on its own under every sampler, so each sample is unbiased. Under the
+//! stratified ones the samples of one pixel are correlated with each other, and a strategy that
 //! learns from a pixel's earlier samples (heuristic 2's hit tallies, N_max per pass) learns from
 //! numbers correlated with the later ones; the convergence tests check that the images agree.
 use serde::{Deserialize, Serialize};
@@ -26,18 +35,30 @@ pub enum Sampler {
     /// Independent uniform numbers per dimension.
     #[default]
     Independent,
+    /// Jittered strata per dimension pair, over the render's spp.
+    Stratified,
     /// Shuffled, Owen-scrambled (0,2)-sequences in consecutive dimension pairs.
     Sobol,
+    /// Shuffled, XOR-scrambled (0,2)-sequences in consecutive dimension pairs (pbrt-v3).
+    #[serde(rename = "lowdiscrepancy")]
+    LowDiscrepancy,
 }
 
 impl Sampler {
-    pub const ALL: [Sampler; 2] = [Sampler::Independent, Sampler::Sobol];
+    pub const ALL: [Sampler; 4] = [
+        Sampler::Independent,
+        Sampler::Stratified,
+        Sampler::Sobol,
+        Sampler::LowDiscrepancy,
+    ];
 
     /// The name on the command line and in the render's JSON.
     pub fn name(self) -> &'static str {
         match self {
             Sampler::Independent => "independent",
+            Sampler::Stratified => "stratified",
             Sampler::Sobol => "sobol",
+            Sampler::LowDiscrepancy => "lowdiscrepancy",
         }
     }
 
@@ -45,12 +66,48 @@ impl Sampler {
     pub fn from_name(name: &str) -> Option<Sampler> {
         Sampler::ALL.into_iter().find(|s| s.name() == name)
     }
+
+    /// Whether the sampler needs to know a pixel's sample count in advance.
+    pub fn needs_spp(self) -> bool {
+        self == Sampler::Stratified
+    }
+
+    /// Whether a 2D draw must start on an even dimension (a pair of the sequence).
+    #[inline]
+    pub(crate) fn pairs_dimensions(self) -> bool {
+        self != Sampler::Independent
+    }
+
+    /// The 64 bits of dimension `dim` of the sample at `at`, from the independent hash
+    /// `independent` of the same dimension.
+    #[inline]
+    pub(crate) fn bits(self, at: &SamplePosition, dim: u32, independent: u64) -> u64 {
+        let sequence = match self {
+            Sampler::Independent => return independent,
+            Sampler::Stratified => stratified_value(at, dim, independent),
+            Sampler::Sobol => sobol_value(at.pixel_key, at.index, dim),
+            Sampler::LowDiscrepancy => xor_scrambled_sobol_value(at.pixel_key, at.index, dim),
+        };
+        // The sequence's 32 bits on top, independent ones below them.
+        ((sequence as u64) << 32) | (independent & 0xffff_ffff)
+    }
 }
 
 impl std::fmt::Display for Sampler {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// Which sample of which pixel a stream draws for.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct SamplePosition {
+    /// A hash of (seed, pixel).
+    pub pixel_key: u64,
+    /// The sample's index within its pixel.
+    pub index: u32,
+    /// The pixel's planned sample count (`stratified` only; 0 if unknown).
+    pub pixel_samples: u32,
 }
 
 /// Laine and Karras's permutation as Burley gives it: every output bit depends only on the
@@ -89,19 +146,84 @@ fn sobol_second(mut index: u32) -> u32 {
     r
 }
 
+/// The hash of one dimension pair of one pixel, from which its shuffle and scrambles come.
+#[inline]
+fn pair_hash(pixel_key: u64, dim: u32) -> u64 {
+    crate::rng::mix64(pixel_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93))
+}
+
+/// The unscrambled Sobol coordinate of dimension `dim`'s pair at the shuffled index, and the
+/// pair's hash.
+#[inline]
+fn shuffled_sobol(pixel_key: u64, index: u32, dim: u32) -> (u32, u32) {
+    let pair = pair_hash(pixel_key, dim);
+    let shuffled = owen_scramble(index, pair as u32);
+    if dim % 2 == 0 {
+        (shuffled.reverse_bits(), (pair >> 32) as u32)
+    } else {
+        (sobol_second(shuffled), crate::rng::mix64(pair) as u32)
+    }
+}
+
 /// The `sobol` sampler's value (a 32-bit fraction) of sample `index` in dimension `dim`, for
 /// the pixel whose hash is `pixel_key`.
 #[inline]
 pub fn sobol_value(pixel_key: u64, index: u32, dim: u32) -> u32 {
-    let pair =
-        crate::rng::mix64(pixel_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93));
-    let shuffled = owen_scramble(index, pair as u32);
-    let (raw, scramble) = if dim % 2 == 0 {
-        (shuffled.reverse_bits(), (pair >> 32) as u32)
-    } else {
-        (sobol_second(shuffled), crate::rng::mix64(pair) as u32)
-    };
+    let (raw, scramble) = shuffled_sobol(pixel_key, index, dim);
     owen_scramble(raw, scramble)
+}
+
+/// The `lowdiscrepancy` sampler's value: [`sobol_value`]'s point with a random-digit scramble.
+#[inline]
+pub fn xor_scrambled_sobol_value(pixel_key: u64, index: u32, dim: u32) -> u32 {
+    let (raw, scramble) = shuffled_sobol(pixel_key, index, dim);
+    raw ^ scramble
+}
+
+/// A permutation of 0..n (n ≥ 1) keyed by `seed`, in the manner of Kensler 2013: rounds of
+/// bijections of [0, 2^b) (xor with a key, multiplication by an odd number, a right
+/// xor-shift), walked along the cycle until the value lands below n.
+#[inline]
+fn permute_below(i: u32, n: u32, seed: u64) -> u32 {
+    let bits = 32 - (n - 1).leading_zeros();
+    if bits == 0 {
+        return 0;
+    }
+    let mask = u32::MAX >> (32 - bits);
+    let shift = bits.div_ceil(2);
+    let mut x = i;
+    loop {
+        let mut key = seed;
+        for _ in 0..4 {
+            key = crate::rng::mix64(key);
+            x = ((x ^ key as u32) & mask).wrapping_mul((key >> 32) as u32 | 1) & mask;
+            x ^= x >> shift;
+        }
+        if x < n {
+            return x;
+        }
+    }
+}
+
+/// The `stratified` sampler's value: the pair's square cut into nx × ny cells (nx = ⌊√spp⌋,
+/// ny = ⌈spp/nx⌉), sample `index` in a permuted cell, jittered by the independent bits.
+#[inline]
+fn stratified_value(at: &SamplePosition, dim: u32, independent: u64) -> u32 {
+    let spp = at.pixel_samples.max(1);
+    let nx = (spp as f64).sqrt() as u32;
+    let ny = spp.div_ceil(nx);
+    let pair = pair_hash(at.pixel_key, dim);
+    // Samples past the planned count (none, when spp is the limit) reuse the permutation.
+    let cell = permute_below(at.index % (nx * ny), nx * ny, pair);
+    let (strata, stratum) = if dim % 2 == 0 {
+        (nx, cell % nx)
+    } else {
+        (ny, cell / nx)
+    };
+    // The cell's share of 2^32, with the jitter's 32 bits spread over it.
+    let jitter = ((independent >> 32) * (((1u64 << 32) / strata as u64) as u64)) >> 32;
+    let base = (stratum as u64 * (1u64 << 32)) / strata as u64;
+    (base + jitter).min(u32::MAX as u64) as u32
 }
 
 #[cfg(test)]
@@ -143,9 +265,20 @@ mod tests {
     }
 
     fn pair_points(sampler: Sampler, pixel: u64, n: u32, dims: (u32, u32)) -> Vec<(f64, f64)> {
+        pair_points_of(sampler, pixel, n, n, dims)
+    }
+
+    fn pair_points_of(
+        sampler: Sampler,
+        pixel: u64,
+        n: u32,
+        spp: u32,
+        dims: (u32, u32),
+    ) -> Vec<(f64, f64)> {
         (0..n)
             .map(|i| {
-                let mut s = SampleStream::with_sampler(sampler, 5, pixel, i as u64);
+                let mut s =
+                    SampleStream::with_sampler(sampler, 5, pixel, i as u64).with_pixel_samples(spp);
                 let mut v = [0.0f64; 64];
                 for x in v.iter_mut().take(dims.1.max(dims.0) as usize + 1) {
                     *x = (s.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
@@ -160,9 +293,12 @@ mod tests {
     #[test]
     fn every_pair_of_a_pixel_is_a_net() {
         let m = 6u32;
-        for pixel in [0u64, 17, 1 << 40] {
+        for (sampler, pixel) in [Sampler::Sobol, Sampler::LowDiscrepancy]
+            .into_iter()
+            .flat_map(|s| [0u64, 17, 1 << 40].map(|p| (s, p)))
+        {
             for dims in [(0, 1), (6, 7), (30, 31)] {
-                let pts = pair_points(Sampler::Sobol, pixel, 1 << m, dims);
+                let pts = pair_points(sampler, pixel, 1 << m, dims);
                 for a in 0..=m {
                     let (nx, ny) = (1usize << a, 1usize << (m - a));
                     let mut cells = vec![0u32; nx * ny];
@@ -171,7 +307,7 @@ mod tests {
                     }
                     assert!(
                         cells.iter().all(|&c| c == 1),
-                        "pixel {pixel}, dims {dims:?}, intervals {nx}x{ny}"
+                        "{sampler}: pixel {pixel}, dims {dims:?}, intervals {nx}x{ny}"
                     );
                 }
             }
@@ -183,26 +319,60 @@ mod tests {
     /// bits would agree for every sample, and this chi-square would be about 256).
     #[test]
     fn pairs_are_decorrelated_from_each_other() {
-        let pts = pair_points(Sampler::Sobol, 3, 1024, (0, 2));
-        let mut cells = [0u32; 64];
-        for &(x, y) in &pts {
-            cells[(x * 8.0) as usize * 8 + (y * 8.0) as usize] += 1;
+        for sampler in Sampler::ALL {
+            let pts = pair_points(sampler, 3, 1024, (0, 2));
+            let mut cells = [0u32; 64];
+            for &(x, y) in &pts {
+                cells[(x * 8.0) as usize * 8 + (y * 8.0) as usize] += 1;
+            }
+            let e = 1024.0 / 64.0;
+            let chi2: f64 = cells.iter().map(|&o| (o as f64 - e).powi(2) / e).sum();
+            // 63 degrees of freedom: p = 1e-4 at 110.
+            assert!(chi2 < 110.0, "{sampler}: chi2 = {chi2}");
         }
-        let e = 1024.0 / 64.0;
-        let chi2: f64 = cells.iter().map(|&o| (o as f64 - e).powi(2) / e).sum();
-        // 63 degrees of freedom: p = 1e-4 at 110.
-        assert!(chi2 < 110.0, "chi2 = {chi2}");
+    }
+
+    /// `stratified` puts one sample in each of its nx × ny cells when spp fills them, and
+    /// never two in one cell when it does not (spp 50: 7 × 8 cells).
+    #[test]
+    fn stratified_samples_fill_distinct_cells() {
+        for (spp, nx, ny) in [(64u32, 8usize, 8usize), (50, 7, 8), (2, 1, 2)] {
+            for dims in [(0, 1), (8, 9)] {
+                let pts = pair_points_of(Sampler::Stratified, 11, spp, spp, dims);
+                let mut cells = vec![0u32; nx * ny];
+                for &(x, y) in &pts {
+                    cells[(x * nx as f64) as usize * ny + (y * ny as f64) as usize] += 1;
+                }
+                assert!(
+                    cells.iter().all(|&c| c <= 1),
+                    "spp {spp}, dims {dims:?}: {cells:?}"
+                );
+                assert_eq!(cells.iter().sum::<u32>(), spp);
+            }
+        }
+    }
+
+    #[test]
+    fn permutations_below_n_are_bijections() {
+        for n in [1u32, 2, 3, 7, 56, 100, 1000] {
+            let mut seen: Vec<u32> = (0..n).map(|i| permute_below(i, n, 0x5eed)).collect();
+            seen.sort_unstable();
+            assert_eq!(seen, (0..n).collect::<Vec<_>>());
+        }
     }
 
     /// Across pixels every dimension is uniform, odd ones drawn alone included (one sample per
     /// pixel, 16 bins, p = 1e-4 bound 44.3 for 15 degrees of freedom).
     #[test]
     fn each_dimension_is_uniform_across_pixels() {
-        for dim in [0u32, 1, 5, 12] {
+        for (sampler, dim) in Sampler::ALL
+            .into_iter()
+            .flat_map(|s| [0u32, 1, 5, 12].map(|d| (s, d)))
+        {
             let mut bins = [0u32; 16];
             let n = 64_000;
             for pixel in 0..n {
-                let mut s = SampleStream::with_sampler(Sampler::Sobol, 9, pixel, 3);
+                let mut s = SampleStream::with_sampler(sampler, 9, pixel, 3).with_pixel_samples(16);
                 for _ in 0..dim {
                     s.next_u64();
                 }
@@ -210,24 +380,26 @@ mod tests {
             }
             let e = n as f64 / 16.0;
             let chi2: f64 = bins.iter().map(|&o| (o as f64 - e).powi(2) / e).sum();
-            assert!(chi2 < 44.3, "dim {dim}: chi2 = {chi2}");
+            assert!(chi2 < 44.3, "{sampler} dim {dim}: chi2 = {chi2}");
         }
     }
 
     /// `next_2d` starts a pair on an even dimension, so its two numbers are one net point.
     #[test]
     fn next_2d_takes_a_whole_pair() {
-        let mut pts = Vec::new();
-        for i in 0..64u64 {
-            let mut s = SampleStream::with_sampler(Sampler::Sobol, 1, 2, i);
-            s.next_f32();
-            pts.push(s.next_2d());
-            assert_eq!(s.dimension(), 4);
+        for sampler in [Sampler::Stratified, Sampler::Sobol, Sampler::LowDiscrepancy] {
+            let mut pts = Vec::new();
+            for i in 0..64u64 {
+                let mut s = SampleStream::with_sampler(sampler, 1, 2, i).with_pixel_samples(64);
+                s.next_f32();
+                pts.push(s.next_2d());
+                assert_eq!(s.dimension(), 4);
+            }
+            let mut cells = [0u32; 64];
+            for p in &pts {
+                cells[(p.x * 8.0) as usize * 8 + (p.y * 8.0) as usize] += 1;
+            }
+            assert!(cells.iter().all(|&c| c == 1), "{sampler}");
         }
-        let mut cells = [0u32; 64];
-        for p in &pts {
-            cells[(p.x * 8.0) as usize * 8 + (p.y * 8.0) as usize] += 1;
-        }
-        assert!(cells.iter().all(|&c| c == 1));
     }
 }

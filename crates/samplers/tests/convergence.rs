@@ -63,6 +63,32 @@ fn baseline_strategies_agree_on_a_mixed_scene() {
     }
 }
 
+/// Every sampler gives the image of independent numbers, for a strategy of each family: the
+/// samples are stratified, not biased, the adaptive method's between-pass learning included.
+/// (The comparison is conservative under the stratified samplers: their per-pixel sample
+/// variance overstates the variance of their mean.)
+#[test]
+fn every_sampler_converges_to_the_same_image() {
+    use render_core::sampler::Sampler;
+    let scene = common::mixed_scene(40);
+    let opts = StrategyOptions::default();
+    let reference = render_with(&scene, "power+bsdf", 256, 2, 1);
+    for sampler in Sampler::ALL
+        .into_iter()
+        .filter(|&s| s != Sampler::Independent)
+    {
+        for (name, spp) in [("power+bsdf", 64), ("tree+bsdf", 64), ("mis3-adaptive", 16)] {
+            let r = common::render_sampled(&scene, name, &opts, spp, (2, 3), None, sampler);
+            let failures = compare(&reference, &r, 2, 3.0);
+            assert!(
+                failures.is_empty(),
+                "{name} under {sampler} vs power+bsdf:\n{}",
+                failures.join("\n")
+            );
+        }
+    }
+}
+
 /// The oracle and the RIS strategies (issue 13) against power+bsdf, on the mixed scene and on
 /// glossy spheres (rough enough for 32 spp to be past the heavy-tailed regime, see method.rs).
 #[test]
@@ -167,6 +193,7 @@ fn a_strategy_object_renders_the_same_image_twice() {
         threads: Some(2),
         camera,
         sampler: Default::default(),
+        filter: Default::default(),
     };
     let a = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
     let b = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
@@ -204,6 +231,7 @@ fn bisml_cornell_from_pbrt_agrees_with_its_gltf() {
             threads: Some(2),
             camera,
             sampler: Default::default(),
+            filter: Default::default(),
         };
         render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
     };

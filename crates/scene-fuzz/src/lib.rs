@@ -320,6 +320,7 @@ fn load_and_render(path: &Path, case: u64) -> Result<Outcome, String> {
         threads: Some(1),
         camera,
         sampler: Default::default(),
+        filter: Default::default(),
     };
     match render_core::render::render(&scene, strategy.as_ref(), &settings, &|_, _| {}) {
         Ok(r) => {

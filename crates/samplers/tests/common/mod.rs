@@ -210,6 +210,27 @@ pub fn render_opts(
     seed: u64,
     size: Option<(u32, u32)>,
 ) -> RenderResult {
+    render_sampled(
+        scene,
+        name,
+        opts,
+        spp,
+        (threads, seed),
+        size,
+        Default::default(),
+    )
+}
+
+/// [`render_opts`] with the numbers from `sampler`.
+pub fn render_sampled(
+    scene: &Scene,
+    name: &str,
+    opts: &samplers::StrategyOptions,
+    spp: u32,
+    (threads, seed): (usize, u64),
+    size: Option<(u32, u32)>,
+    sampler: render_core::sampler::Sampler,
+) -> RenderResult {
     let strategy = samplers::create(name, scene, opts).unwrap();
     let mut camera = scene.camera(None).unwrap();
     if let Some((w, h)) = size {
@@ -224,7 +245,8 @@ pub fn render_opts(
         time_budget: None,
         threads: Some(threads),
         camera,
-        sampler: Default::default(),
+        sampler,
+        filter: Default::default(),
     };
     render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
 }

@@ -408,6 +408,7 @@ fn every_builtin_renders_a_lit_image() {
             threads: Some(1),
             camera,
             sampler: Default::default(),
+            filter: Default::default(),
         };
         let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
         // Leave out pixels that see a light directly: the rest is reflected light.
