@@ -22,10 +22,11 @@ pub struct RenderArgs {
     pub spp: Option<u32>,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Where the samples' numbers come from: `independent` numbers per dimension, or `sobol`,
-    /// shuffled Owen-scrambled (0,2)-sequences in consecutive dimension pairs.
-    #[arg(long, default_value_t = Sampler::Independent, value_parser = sampler_parser())]
-    pub sampler: Sampler,
+    /// Where the samples' numbers come from: `independent` numbers per dimension (the default),
+    /// `stratified` (jittered, needs --spp), `sobol` (Owen-scrambled (0,2)-sequences per
+    /// dimension pair) or `lowdiscrepancy` (pbrt-v3's, the default under --reproduce).
+    #[arg(long, value_parser = sampler_parser())]
+    pub sampler: Option<Sampler>,
     /// The pixel filter, `NAME[:RADIUS]`: box (radius 0.5 by default), triangle (2), gaussian
     /// (1.5, sigma 0.5) or mitchell (2, B = C = 1/3), sampled by filter importance sampling.
     #[arg(long, default_value = "box", value_parser = PixelFilter::parse)]
@@ -235,6 +236,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
     }
     let opts = args.method.options(args.tau, args.max_cut);
+    let sampler = args.sampler.unwrap_or(if opts.reproduce {
+        Sampler::LowDiscrepancy
+    } else {
+        Sampler::Independent
+    });
     let strategy = samplers::create(&args.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
@@ -268,7 +274,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }),
         threads: args.threads,
         camera: camera.clone(),
-        sampler: args.sampler,
+        sampler,
         filter: args.filter.clone(),
     };
     let bar = if args.quiet {
@@ -343,7 +349,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "time_budget_s": args.time_budget,
         "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
         "seed": args.seed,
-        "sampler": args.sampler.name(),
+        "sampler": sampler.name(),
         "filter": {
             "name": args.filter.name(),
             "parameters": args.filter.parameters().into_iter().collect::<std::collections::BTreeMap<_, _>>(),
