@@ -24,7 +24,8 @@ pub struct RenderArgs {
     pub seed: u64,
     /// Where the samples' numbers come from: `independent` numbers per dimension (the default),
     /// `stratified` (jittered, needs --spp), `sobol` (Owen-scrambled (0,2)-sequences per
-    /// dimension pair) or `lowdiscrepancy` (pbrt-v3's, the default under --reproduce).
+    /// dimension pair), `lowdiscrepancy` (pbrt-v3's, the default under --reproduce) or
+    /// `zsobol` (pbrt-v4's: one sequence over the image in Morton order, needs --spp).
     #[arg(long, value_parser = sampler_parser())]
     pub sampler: Option<Sampler>,
     /// The pixel filter, `NAME[:RADIUS]`: box (radius 0.5 by default), triangle (2), gaussian

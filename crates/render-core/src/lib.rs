@@ -28,6 +28,7 @@ pub mod sampling;
 pub mod scene;
 pub mod stats;
 pub mod texture;
+pub mod zsobol;
 
 pub use error::SceneError;
 pub use glam::{Vec2, Vec3};

@@ -205,7 +205,8 @@ impl PassJob<'_> {
                 index as u64,
                 sample_index,
             )
-            .with_pixel_samples(self.settings.spp.unwrap_or(0));
+            .with_pixel_samples(self.settings.spp.unwrap_or(0))
+            .in_image((x as u32, y as u32), (w as u32, h as u32));
             let (offset, weight) = self.settings.filter.sample(rng.next_2d());
             let film = Vec2::new(
                 (x as f32 + offset.x) / w as f32,

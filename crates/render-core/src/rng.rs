@@ -2,6 +2,7 @@
 //! (seed, pixel, sample index, dimension), never on thread scheduling, so an image is
 //! bit-identical whatever the thread count. Which value that is, the [`Sampler`] decides.
 use crate::sampler::{SamplePosition, Sampler};
+use crate::zsobol::ZOrder;
 
 /// The stream of uniform numbers of one pixel sample.
 #[derive(Clone, Debug)]
@@ -34,7 +35,8 @@ impl SampleStream {
         pixel: u64,
         sample_index: u64,
     ) -> SampleStream {
-        let pixel_key = mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel);
+        let seed_key = mix64(seed ^ 0x9e37_79b9_7f4a_7c15);
+        let pixel_key = mix64(seed_key ^ pixel);
         let key = mix64(pixel_key ^ sample_index.wrapping_mul(0xd1b5_4a32_d192_ed03));
         SampleStream {
             key,
@@ -44,6 +46,10 @@ impl SampleStream {
                 pixel_key,
                 index: sample_index as u32,
                 pixel_samples: 0,
+                z: ZOrder {
+                    seed_key,
+                    ..ZOrder::default()
+                },
             },
         }
     }
@@ -52,6 +58,16 @@ impl SampleStream {
     /// cuts its strata by it).
     pub fn with_pixel_samples(mut self, spp: u32) -> SampleStream {
         self.at.pixel_samples = spp;
+        self
+    }
+
+    /// The same stream, told that its pixel is (x, y) of a `width` × `height` image (the
+    /// `zsobol` sampler orders pixels along a Morton curve; call after `with_pixel_samples`).
+    pub fn in_image(mut self, (x, y): (u32, u32), (width, height): (u32, u32)) -> SampleStream {
+        if self.sampler == Sampler::ZSobol {
+            let (spp, i) = (self.at.pixel_samples, self.at.index);
+            self.at.z = ZOrder::new(self.at.z.seed_key, (x, y), (width, height), spp, i);
+        }
         self
     }
 

@@ -21,6 +21,9 @@
 //!   same shuffled pairs, randomised by a random-digit (XOR) scramble per pixel and dimension
 //!   instead of Owen's. pbrt-v3 draws a fixed power-of-two set per pixel and shuffles it;
 //!   ours is the progressive equivalent (every power-of-two prefix is a net).
+//! - `zsobol`: one Owen-scrambled Sobol sequence over the whole image, handed out to pixels
+//!   along a shuffled Morton curve (pbrt-v4's ZSobol, [`crate::zsobol`]): blue-noise error
+//!   across pixels. Needs the render's spp.
 //!
 //! Every value is uniform on its own under every sampler, so each sample is unbiased. Under the
 //! stratified ones the samples of one pixel are correlated with each other, and a strategy that
@@ -42,14 +45,18 @@ pub enum Sampler {
     /// Shuffled, XOR-scrambled (0,2)-sequences in consecutive dimension pairs (pbrt-v3).
     #[serde(rename = "lowdiscrepancy")]
     LowDiscrepancy,
+    /// One Sobol sequence over the image in shuffled Morton order (pbrt-v4's ZSobol).
+    #[serde(rename = "zsobol")]
+    ZSobol,
 }
 
 impl Sampler {
-    pub const ALL: [Sampler; 4] = [
+    pub const ALL: [Sampler; 5] = [
         Sampler::Independent,
         Sampler::Stratified,
         Sampler::Sobol,
         Sampler::LowDiscrepancy,
+        Sampler::ZSobol,
     ];
 
     /// The name on the command line and in the render's JSON.
@@ -59,6 +66,7 @@ impl Sampler {
             Sampler::Stratified => "stratified",
             Sampler::Sobol => "sobol",
             Sampler::LowDiscrepancy => "lowdiscrepancy",
+            Sampler::ZSobol => "zsobol",
         }
     }
 
@@ -69,7 +77,7 @@ impl Sampler {
 
     /// Whether the sampler needs to know a pixel's sample count in advance.
     pub fn needs_spp(self) -> bool {
-        self == Sampler::Stratified
+        matches!(self, Sampler::Stratified | Sampler::ZSobol)
     }
 
     /// Whether a 2D draw must start on an even dimension (a pair of the sequence).
@@ -87,6 +95,7 @@ impl Sampler {
             Sampler::Stratified => stratified_value(at, dim, independent),
             Sampler::Sobol => sobol_value(at.pixel_key, at.index, dim),
             Sampler::LowDiscrepancy => xor_scrambled_sobol_value(at.pixel_key, at.index, dim),
+            Sampler::ZSobol => crate::zsobol::zsobol_value(&at.z, dim),
         };
         // The sequence's 32 bits on top, independent ones below them.
         ((sequence as u64) << 32) | (independent & 0xffff_ffff)
@@ -108,6 +117,8 @@ pub(crate) struct SamplePosition {
     pub index: u32,
     /// The pixel's planned sample count (`stratified` only; 0 if unknown).
     pub pixel_samples: u32,
+    /// The sample's place in the image's sequence (`zsobol` only).
+    pub z: crate::zsobol::ZOrder,
 }
 
 /// Laine and Karras's permutation as Burley gives it: every output bit depends only on the
@@ -264,6 +275,14 @@ mod tests {
         }
     }
 
+    /// Sample `i` of `pixel`, read as a pixel of a 256 × 65536 image.
+    fn stream(sampler: Sampler, seed: u64, pixel: u64, i: u64, spp: u32) -> SampleStream {
+        let xy = ((pixel % 256) as u32, (pixel / 256 % 65536) as u32);
+        SampleStream::with_sampler(sampler, seed, pixel, i)
+            .with_pixel_samples(spp)
+            .in_image(xy, (256, 65536))
+    }
+
     fn pair_points(sampler: Sampler, pixel: u64, n: u32, dims: (u32, u32)) -> Vec<(f64, f64)> {
         pair_points_of(sampler, pixel, n, n, dims)
     }
@@ -277,8 +296,7 @@ mod tests {
     ) -> Vec<(f64, f64)> {
         (0..n)
             .map(|i| {
-                let mut s =
-                    SampleStream::with_sampler(sampler, 5, pixel, i as u64).with_pixel_samples(spp);
+                let mut s = stream(sampler, 5, pixel, i as u64, spp);
                 let mut v = [0.0f64; 64];
                 for x in v.iter_mut().take(dims.1.max(dims.0) as usize + 1) {
                     *x = (s.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
@@ -372,7 +390,7 @@ mod tests {
             let mut bins = [0u32; 16];
             let n = 64_000;
             for pixel in 0..n {
-                let mut s = SampleStream::with_sampler(sampler, 9, pixel, 3).with_pixel_samples(16);
+                let mut s = stream(sampler, 9, pixel, 3, 16);
                 for _ in 0..dim {
                     s.next_u64();
                 }
