@@ -30,8 +30,9 @@ pub struct RenderArgs {
     pub sampler: Option<Sampler>,
     /// The pixel filter, `NAME[:RADIUS]`: box (radius 0.5 by default), triangle (2), gaussian
     /// (1.5, sigma 0.5) or mitchell (2, B = C = 1/3), sampled by filter importance sampling.
-    #[arg(long, default_value = "box", value_parser = PixelFilter::parse)]
-    pub filter: PixelFilter,
+    /// The scene file's own `PixelFilter` is used when this is not given.
+    #[arg(long, value_parser = PixelFilter::parse)]
+    pub filter: Option<PixelFilter>,
     #[arg(long)]
     pub width: Option<u32>,
     #[arg(long)]
@@ -136,6 +137,21 @@ fn brdf_integral_parser() -> impl clap::builder::TypedValueParser<Value = BrdfIn
     PossibleValuesParser::new(BrdfIntegral::ALL.map(BrdfIntegral::name)).try_map(|s| s.parse())
 }
 
+/// The sampler a render uses, and why: `--sampler`, else the scene file's, else pbrt-v3's
+/// `lowdiscrepancy` under `--reproduce`, else `independent`.
+fn choose_sampler(
+    flag: Option<Sampler>,
+    scene: &render_core::scene::Scene,
+    reproduce: bool,
+) -> (Sampler, &'static str) {
+    match (flag, scene.render_hints.sampler) {
+        (Some(s), _) => (s, "--sampler"),
+        (None, Some(s)) => (s, "scene file"),
+        (None, None) if reproduce => (Sampler::LowDiscrepancy, "--reproduce"),
+        (None, None) => (Sampler::Independent, "default"),
+    }
+}
+
 /// `--sampler`: the names of [`Sampler`], listed in `--help`.
 fn sampler_parser() -> impl clap::builder::TypedValueParser<Value = Sampler> {
     use clap::builder::{PossibleValuesParser, TypedValueParser};
@@ -237,11 +253,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }
     }
     let opts = args.method.options(args.tau, args.max_cut);
-    let sampler = args.sampler.unwrap_or(if opts.reproduce {
-        Sampler::LowDiscrepancy
-    } else {
-        Sampler::Independent
-    });
+    let (sampler, sampler_from) = choose_sampler(args.sampler, &scene, opts.reproduce);
+    let (filter, filter_from) = match (&args.filter, &scene.render_hints.filter) {
+        (Some(f), _) => (f.clone(), "--filter"),
+        (None, Some(f)) => (f.clone(), "scene file"),
+        (None, None) => (PixelFilter::default(), "default"),
+    };
     let strategy = samplers::create(&args.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
@@ -276,7 +293,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         threads: args.threads,
         camera: camera.clone(),
         sampler,
-        filter: args.filter.clone(),
+        filter: filter.clone(),
     };
     let bar = if args.quiet {
         ProgressBar::hidden()
@@ -351,9 +368,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
         "seed": args.seed,
         "sampler": sampler.name(),
+        "sampler_from": sampler_from,
         "filter": {
-            "name": args.filter.name(),
-            "parameters": args.filter.parameters().into_iter().collect::<std::collections::BTreeMap<_, _>>(),
+            "name": filter.name(),
+            "parameters": filter.parameters().into_iter().collect::<std::collections::BTreeMap<_, _>>(),
+            "from": filter_from,
         },
         "width": width,
         "height": height,

@@ -26,6 +26,7 @@ pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod scene_hints;
 pub mod stats;
 pub mod texture;
 pub mod zsobol;

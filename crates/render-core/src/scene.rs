@@ -70,6 +70,8 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     pub bounds: (Vec3, Vec3),
     pub stats: SceneStats,
+    /// The sampler and filter the scene file asks for, if any.
+    pub render_hints: crate::scene_hints::RenderHints,
     pub accel: Accel,
 }
 
@@ -204,6 +206,7 @@ pub struct SceneBuilder {
     distant: Vec<DistantLight>,
     cameras: Vec<Camera>,
     stats: SceneStats,
+    render_hints: crate::scene_hints::RenderHints,
 }
 
 /// The largest coordinate (and sphere radius) a scene may have: squares and areas of larger
@@ -285,7 +288,13 @@ impl SceneBuilder {
             distant: Vec::new(),
             cameras: Vec::new(),
             stats: SceneStats::default(),
+            render_hints: Default::default(),
         }
+    }
+
+    /// Records the sampler and filter the scene file asks for.
+    pub fn set_render_hints(&mut self, hints: crate::scene_hints::RenderHints) {
+        self.render_hints = hints;
     }
 
     pub fn add_material(&mut self, m: Material) -> Result<u32, SceneError> {
@@ -571,6 +580,7 @@ impl SceneBuilder {
             cameras: self.cameras,
             bounds: (lo, hi),
             stats: self.stats,
+            render_hints: self.render_hints,
             accel,
         })
     }
