@@ -82,6 +82,17 @@ impl PixelFilter {
         })
     }
 
+    /// A radius the filters accept: (0, 16] pixels.
+    pub fn check_radius(r: f32) -> Result<(), String> {
+        if r.is_finite() && r > 0.0 && r <= 16.0 {
+            Ok(())
+        } else {
+            Err(format!(
+                "a filter radius must be in (0, 16] pixels, not {r}"
+            ))
+        }
+    }
+
     /// `NAME[:RADIUS]`, as `--filter` takes it.
     pub fn parse(spec: &str) -> Result<PixelFilter, String> {
         let (name, radius) = match spec.split_once(':') {

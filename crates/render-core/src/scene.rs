@@ -292,9 +292,9 @@ impl SceneBuilder {
         }
     }
 
-    /// Records the sampler and filter the scene file asks for.
-    pub fn set_render_hints(&mut self, hints: crate::scene_hints::RenderHints) {
-        self.render_hints = hints;
+    /// The sampler and filter the scene file asks for, to fill in as the file is read.
+    pub fn render_hints_mut(&mut self) -> &mut crate::scene_hints::RenderHints {
+        &mut self.render_hints
     }
 
     pub fn add_material(&mut self, m: Material) -> Result<u32, SceneError> {

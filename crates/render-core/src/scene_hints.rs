@@ -30,3 +30,28 @@ pub fn sampler_for_pbrt(name: &str) -> Option<(Sampler, bool)> {
         _ => return None,
     })
 }
+
+/// The pbrt name of our sampler, the inverse of [`sampler_for_pbrt`]'s exact matches.
+pub fn pbrt_name(sampler: Sampler) -> &'static str {
+    match sampler {
+        Sampler::Independent => "independent",
+        Sampler::Stratified => "stratified",
+        Sampler::Sobol => "paddedsobol",
+        Sampler::LowDiscrepancy => "lowdiscrepancy",
+        Sampler::ZSobol => "zsobol",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pbrt_names_round_trip() {
+        for s in Sampler::ALL {
+            assert_eq!(sampler_for_pbrt(pbrt_name(s)), Some((s, true)));
+        }
+        assert_eq!(sampler_for_pbrt("halton"), Some((Sampler::Sobol, false)));
+        assert_eq!(sampler_for_pbrt("nonsense"), None);
+    }
+}

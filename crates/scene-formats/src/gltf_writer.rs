@@ -252,6 +252,9 @@ pub fn write_glb(scene: &Scene, path: &Path) -> Result<Vec<String>, SceneError> 
     if let Some(c) = scene.cameras.first() {
         doc["extras"] = json!({ "film": { "width": c.width, "height": c.height } });
     }
+    if let Some(pbrt) = crate::gltf_reader::hints_extras(&scene.render_hints) {
+        doc["extras"]["pbrt"] = pbrt;
+    }
     let mut text = serde_json::to_vec(&doc).map_err(|e| io_err(path, e.to_string()))?;
     while text.len() % 4 != 0 {
         text.push(b' ');

@@ -46,6 +46,8 @@ mod materials;
 mod meshes;
 mod nodes;
 pub mod pbrt_extras;
+mod render_hints;
+pub use render_hints::hints_extras;
 mod textures;
 
 #[cfg(test)]

@@ -13,6 +13,7 @@ impl Loader<'_> {
     /// Walks the nodes under `root` (depth first, in file order), adding their meshes, lights
     /// and cameras.
     pub(super) fn load(&mut self, root: Mat4) -> Result<(), SceneError> {
+        self.read_render_hints()?;
         let doc = self.doc;
         let roots: Vec<gltf::Node> = match doc.default_scene().or_else(|| doc.scenes().next()) {
             Some(scene) => scene.nodes().collect(),

@@ -313,6 +313,10 @@ fn every_directive_loads_to_the_expected_scene() {
         ("checkerboard", 10),
         ("Integrator", 6),
         ("dielectric rendered as an opaque", 17),
+        (
+            "Sampler \"halton\" is not implemented: the sobol sampler",
+            5,
+        ),
     ] {
         assert!(
             report
@@ -324,6 +328,52 @@ fn every_directive_loads_to_the_expected_scene() {
         );
     }
     assert_eq!(scene.stats.warnings, report.warnings);
+    // Sampler and PixelFilter become render hints (pbrt's default triangle radius is 2).
+    let hints = &scene.render_hints;
+    assert_eq!(
+        (hints.sampler, hints.spp),
+        (Some(render_core::sampler::Sampler::Sobol), Some(16))
+    );
+    assert_eq!(
+        hints.filter,
+        Some(render_core::filter::PixelFilter::Triangle { radius: 2.0 })
+    );
+}
+
+/// pbrt-v3's and pbrt-v4's filter parameters, and filters or samplers we lack.
+#[test]
+fn sampler_and_pixel_filter_become_hints() {
+    use render_core::filter::PixelFilter;
+    use render_core::sampler::Sampler;
+    let hints = |header: &str| {
+        let d = dir(&format!("hints-{}", header.len()));
+        let world = "WorldBegin\nShape \"trianglemesh\" \"point3 P\" [ 0 0 0  1 0 0  0 1 0 ]\n";
+        let path = write(&d, "s.pbrt", &format!("{header}\n{world}"));
+        load_pbrt_with_report(&path, None).map(|(s, r)| (s.render_hints, r.warnings))
+    };
+    let (h, _) = hints("Sampler \"lowdiscrepancy\" \"integer pixelsamples\" [ 4 ]\nPixelFilter \"triangle\" \"float xwidth\" [ 1 ] \"float ywidth\" [ 1 ]").unwrap();
+    assert_eq!(h.sampler, Some(Sampler::LowDiscrepancy));
+    assert_eq!(h.spp, Some(4));
+    assert_eq!(h.filter, Some(PixelFilter::Triangle { radius: 1.0 }));
+    let (h, _) = hints("PixelFilter \"gaussian\" \"float alpha\" 8").unwrap();
+    assert_eq!(h.filter, Some(PixelFilter::gaussian(2.0, 0.25)));
+    let (h, _) = hints(
+        "PixelFilter \"gaussian\" \"float sigma\" 0.7 \"float xradius\" 3 \"float yradius\" 3",
+    )
+    .unwrap();
+    assert_eq!(h.filter, Some(PixelFilter::gaussian(3.0, 0.7)));
+    let (h, _) = hints("PixelFilter \"mitchell\" \"float B\" 0.5 \"float C\" 0.25").unwrap();
+    assert_eq!(h.filter, Some(PixelFilter::mitchell(2.0, 0.5, 0.25)));
+    let (h, w) = hints("PixelFilter \"lanczos\"\nSampler \"fancy\"").unwrap();
+    assert_eq!((h.filter, h.sampler), (Some(PixelFilter::default()), None));
+    assert!(
+        w.iter().any(|w| w.contains("lanczos")) && w.iter().any(|w| w.contains("fancy")),
+        "{w:?}"
+    );
+    let e = hints("PixelFilter \"box\" \"float xwidth\" -1")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("filter radius"), "{e}");
 }
 
 /// The scene converted to glTF and loaded back: same triangles, lights and materials.
@@ -366,6 +416,9 @@ fn convert_round_trips_through_gltf() {
     assert!(
         close(c0.position, c1.position) && close(c0.forward, c1.forward) && close(c0.up, c1.up)
     );
+    // the sampler and filter hints survive the glTF (as extras.pbrt)
+    assert_eq!(back.render_hints, scene.render_hints);
+    assert!(scene.render_hints.filter.is_some());
 }
 
 fn error_of(files: &[(&str, &str)]) -> String {
@@ -420,6 +473,18 @@ fn bisml_cornell_pbrt_loads_like_its_gltf() {
     }
     let (scene, report) = load_pbrt_with_report(&dir.join("pbrt/scene.pbrt"), None).unwrap();
     let glb = crate::gltf_reader::load_gltf(&dir.join("bisml_cornell.glb"), None).unwrap();
+    assert_eq!(
+        (scene.render_hints.sampler, scene.render_hints.spp),
+        (Some(render_core::sampler::Sampler::LowDiscrepancy), Some(4))
+    );
+    assert_eq!(
+        scene.render_hints.filter,
+        Some(render_core::filter::PixelFilter::Triangle { radius: 1.0 })
+    );
+    assert_eq!(
+        glb.render_hints, scene.render_hints,
+        "the glb's extras.pbrt"
+    );
     assert_eq!(scene.stats.sphere_lights, 1494);
     assert_eq!(scene.triangles.len(), glb.triangles.len());
     assert!(
