@@ -46,9 +46,11 @@ pub struct RenderArgs {
     /// Also write an sRGB PNG preview.
     #[arg(long)]
     pub png: Option<PathBuf>,
-    /// Exposure of the PNG preview in stops.
-    #[arg(long, default_value_t = 0.0)]
-    pub exposure: f32,
+    /// Exposure of the PNG preview in stops (negative darkens: `--exposure -3`). Without it, the
+    /// preview is exposed automatically (the 97th percentile of the luminance of the pixels that
+    /// see no light maps to 0.9); the JSON records the exposure used.
+    #[arg(long, allow_negative_numbers = true)]
+    pub exposure: Option<f32>,
     /// Render until this many seconds are spent (checked before each work unit of 256 pixels).
     #[arg(long)]
     pub time_budget: Option<f64>,
@@ -242,6 +244,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if args.threads == Some(0) {
         bail!("--threads must be at least 1");
     }
+    if args.exposure.is_some_and(|e| !e.is_finite()) {
+        bail!("--exposure must be a finite number of stops");
+    }
     check_writable(&args.out)?;
     if let Some(p) = &args.png {
         check_writable(p)?;
@@ -322,8 +327,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         );
     }
     write_exr(&args.out, width, height, &result.pixels).map_err(anyhow::Error::msg)?;
+    let exposure = args.exposure.unwrap_or_else(|| {
+        render_core::colour::auto_exposure_scale(&result.pixels, &result.unlit_mask()).log2()
+    });
     if let Some(p) = &args.png {
-        write_png(p, width, height, &result.pixels, args.exposure).map_err(anyhow::Error::msg)?;
+        write_png(p, width, height, &result.pixels, exposure).map_err(anyhow::Error::msg)?;
     }
     let mut aux_files = Vec::new();
     if args.aux {
@@ -387,6 +395,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "light_selection": result.counters.selection_means(),
         "unlit_pixel_fraction": result.light_fraction.iter().filter(|&&f| f == 0.0).count() as f64 / result.light_fraction.len() as f64,
         "aux_files": aux_files,
+        "png_exposure": args.png.as_ref().map(|_| exposure),
+        "png_exposure_auto": args.png.as_ref().map(|_| args.exposure.is_none()),
         "version": env!("CARGO_PKG_VERSION"),
         "git_commit": option_env!("MANYLIGHTS_GIT_COMMIT").filter(|s| !s.is_empty()),
     });

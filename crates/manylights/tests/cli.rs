@@ -597,3 +597,89 @@ fn sampler_and_filter_are_chosen_and_recorded() {
         "stratified sampler",
     );
 }
+
+/// Mean of the PNG's 8-bit channels and the fraction that are saturated (255).
+fn png_brightness(path: &Path) -> (f64, f64) {
+    let img = image::open(path).expect("a PNG").to_rgb8();
+    let v: Vec<u8> = img.into_raw();
+    let mean = v.iter().map(|&c| c as f64).sum::<f64>() / v.len() as f64;
+    let white = v.iter().filter(|&&c| c == 255).count() as f64 / v.len() as f64;
+    (mean, white)
+}
+
+/// Issue 26's paper cuts: `--exposure -3` is taken as a value (not as a flag), and a bright
+/// scene's preview is not white when no exposure is given (auto exposure, in the JSON).
+#[test]
+fn preview_exposure_negative_and_auto() {
+    let dir = temp_dir("exposure");
+    let scene = dir.join("bright.pbrt");
+    std::fs::write(
+        &scene,
+        "LookAt 0 3 0.01  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" 60\n\
+         Film \"rgb\" \"integer xresolution\" 32 \"integer yresolution\" 24\nWorldBegin\n\
+         Material \"diffuse\" \"rgb reflectance\" [ .5 .5 .5 ]\n\
+         Shape \"bilinearmesh\" \"point3 P\" [ -4 0 -4  4 0 -4  -4 0 4  4 0 4 ]\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 20000 20000 20000 ]\nTranslate 0.5 1 0\n\
+         Shape \"sphere\" \"float radius\" 0.05\nAttributeEnd\n",
+    )
+    .unwrap();
+    let render = |name: &str, extra: &[&str]| -> serde_json::Value {
+        let out = dir.join(format!("{name}.exr"));
+        let png = dir.join(format!("{name}.png"));
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--spp",
+            "2",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+            "--png",
+            png.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        let o = manylights(&args);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap())
+            .unwrap()
+    };
+    // at exposure 0 the scene is bright enough to be mostly white
+    let zero = render("zero", &["--exposure", "0"]);
+    assert_eq!(zero["png_exposure"], 0.0);
+    assert_eq!(zero["png_exposure_auto"], false);
+    let (_, white0) = png_brightness(&dir.join("zero.png"));
+    assert!(white0 > 0.5, "the test scene is bright: {white0}");
+    // `--exposure -3` (a separate negative word) is accepted and darkens the preview
+    let minus3 = render("minus3", &["--exposure", "-3"]);
+    assert_eq!(minus3["png_exposure"], -3.0);
+    let (mean3, _) = png_brightness(&dir.join("minus3.png"));
+    let (mean0, _) = png_brightness(&dir.join("zero.png"));
+    assert!(mean3 < mean0, "{mean3} vs {mean0}");
+    // no --exposure: auto exposure, recorded, negative for this bright scene, and the preview
+    // is neither white nor black
+    let auto = render("auto", &[]);
+    assert_eq!(auto["png_exposure_auto"], true);
+    let e = auto["png_exposure"].as_f64().unwrap();
+    assert!(e < -1.0, "auto exposure {e}");
+    let (mean, white) = png_brightness(&dir.join("auto.png"));
+    assert!(white < 0.05, "{white} of the channels are white");
+    assert!(mean > 20.0 && mean < 235.0, "mean {mean}");
+    // the same seed gives the same preview (the exposure is a function of the image)
+    render("auto2", &[]);
+    assert_eq!(
+        std::fs::read(dir.join("auto.png")).unwrap(),
+        std::fs::read(dir.join("auto2.png")).unwrap()
+    );
+    // bad values fail cleanly
+    let o = manylights(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--exposure",
+        "nan",
+        "--quiet",
+        "--out",
+        dir.join("x.exr").to_str().unwrap(),
+    ]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--exposure must be a finite"));
+}

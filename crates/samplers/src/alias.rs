@@ -12,6 +12,7 @@ struct Bin {
     alias_pmf: f32,
 }
 
+/// Walker's alias table over a discrete distribution: O(1) draws from one cache line.
 #[derive(Clone, Debug)]
 pub struct AliasTable {
     bins: Vec<Bin>,
@@ -58,10 +59,12 @@ impl AliasTable {
         Some(AliasTable { bins })
     }
 
+    /// Number of entries.
     pub fn len(&self) -> usize {
         self.bins.len()
     }
 
+    /// Whether the table has no entry.
     pub fn is_empty(&self) -> bool {
         self.bins.is_empty()
     }
@@ -83,6 +86,7 @@ impl AliasTable {
         }
     }
 
+    /// Probability of entry `i` (what [`AliasTable::sample`] reports with it).
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {
         self.bins[i].pmf

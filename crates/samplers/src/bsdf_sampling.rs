@@ -9,12 +9,15 @@ use render_core::stats::Counters;
 /// A BSDF-sampled direction and what it found.
 #[derive(Clone, Copy, Debug)]
 pub struct BsdfLightHit {
+    /// The sampled direction (world space).
     pub wi: Vec3,
+    /// f·|cos θ| for `wi`.
     pub f_cos: Vec3,
     /// Solid-angle density of `wi`.
     pub pdf: f32,
     /// The light hit first, or [`NO_LIGHT`] (missed everything, or hit a non-emitter).
     pub light: u32,
+    /// Where the ray hit the light.
     pub point: Vec3,
     /// The light's surface normal at `point`.
     pub normal: Vec3,
@@ -23,6 +26,7 @@ pub struct BsdfLightHit {
 }
 
 impl BsdfLightHit {
+    /// Whether the direction reached an emitting light.
     pub fn found_light(&self) -> bool {
         self.light != NO_LIGHT && self.radiance != Vec3::ZERO
     }

@@ -3,21 +3,34 @@
 //! A strategy is a [`render_core::estimator::DirectLighting`]; [`create`] builds one by name.
 //! Every technique can both sample a light point and evaluate the density of any light point,
 //! so strategies combine them by multiple importance sampling.
+//!
+//! **Embedding BRDF-oriented sampling elsewhere.** The BO technique runs from raw inputs: a
+//! [`light_tree::LightTree`] built from the host's light bounds, a
+//! [`brdf_oriented::importance::BoRecord::from_parts`] (position, frame, GGX lobe from
+//! `brdf-integrals`, lobe weights), [`brdf_oriented::technique::BoState::select_from`] with any
+//! source of uniform numbers and `selection_pmf` for MIS; `examples/bo_from_raw.rs` does it,
+//! and its samples pass the chi-square test in the tests. The crate still depends on
+//! `render-core` for `Frame`, `Vec3` and, in the strategies, scenes, lights and `SampleStream`:
+//! splitting the renderer-agnostic techniques into a crate of their own needs `Frame` moved
+//! down (to `light-tree` or a small geometry crate), a point-on-light callback in place of
+//! `BoState::sample_point`'s `Light`, and the three-technique MIS and allocation written
+//! against a trait for "trace a BSDF direction, report the light hit".
 
 // `!(x > 0.0)` is deliberate: it is also true for NaN, which must be rejected too.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
+#![warn(missing_docs)]
 
 pub mod alias;
 pub mod brdf_oriented;
 pub mod bsdf_sampling;
 pub mod convergence;
 pub mod light_strategy;
-pub mod memo;
+mod memo;
 pub mod mis;
 pub mod oracle;
 pub mod point_sets;
 pub mod ris;
-pub mod scratch;
+mod scratch;
 pub mod selection;
 pub mod tree_selection;
 
@@ -47,7 +60,7 @@ pub struct StrategyOptions {
     /// Cap-integral approximation behind BO.
     pub brdf_integral: brdf_oriented::BrdfIntegral,
     /// Every behaviour of the authors' code, for every tree strategy: their power units
-    /// (`LeWithArea`), their E&K σ (scene units, V[e] = 0 from three lights on), no cap on
+    /// (`LeWithArea`), their E&K σ (scene units, `V[e]` = 0 from three lights on), no cap on
     /// either cut; for the method also the nearest SPTD lookup, Oat–Sander cap ∩ cap,
     /// glossy-only importance, their random-number use and the in-sample allocation.
     pub reproduce: bool,
@@ -138,20 +151,31 @@ impl Default for StrategyOptions {
     }
 }
 
+/// Why [`create`] cannot build a strategy.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum StrategyError {
+    /// No strategy of that name.
     #[error("unknown strategy `{name}` (known: {known})")]
-    Unknown { name: String, known: String },
+    Unknown {
+        /// The name asked for.
+        name: String,
+        /// The registered names, comma-separated.
+        known: String,
+    },
+    /// An option out of range for the strategy.
     #[error("bad strategy option: {0}")]
     BadOption(String),
 }
 
 /// A strategy's name and what it does.
 pub struct StrategyInfo {
+    /// The name [`create`] takes.
     pub name: &'static str,
+    /// One line on what it does.
     pub description: &'static str,
 }
 
+/// Every registered strategy.
 pub fn strategies() -> Vec<StrategyInfo> {
     let s = |name, description| StrategyInfo { name, description };
     vec![

@@ -11,10 +11,16 @@ use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
 
+/// Light selection (one or several lights per shading point), with or without BSDF sampling
+/// combined by MIS, as a strategy.
 pub struct LightStrategy<S: LightSelection> {
+    /// The strategy's registered name.
     pub name: String,
+    /// Which lights a shading point samples.
     pub selection: S,
+    /// Add one BSDF sample, combined by the power heuristic.
     pub with_bsdf: bool,
+    /// What the render's JSON records of it.
     pub parameters: serde_json::Value,
 }
 
@@ -23,7 +29,9 @@ pub struct LightStrategy<S: LightSelection> {
 pub struct Picks(pub Vec<(u32, f32)>);
 crate::scratch_pool!(Picks, |p| p.0.clear());
 
+/// Index of light sampling in the technique counters.
 pub const TECHNIQUE_LIGHT: usize = 0;
+/// Index of BSDF sampling in the technique counters.
 pub const TECHNIQUE_BSDF: usize = 1;
 
 /// Samples a point on a picked light (`pmf`: its selection probability) and shades it:

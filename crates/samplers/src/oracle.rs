@@ -25,12 +25,14 @@ pub const DEFENSIVE: f64 = 0.05;
 /// Strata per side of an area light's stratified estimate (k×k points).
 pub const STRATA_PER_SIDE: u32 = 2;
 
+/// The oracle light selection: each light ∝ its estimated unshadowed contribution at the
+/// shading point, mixed with a defensive power fraction ([`DEFENSIVE`]).
 pub struct OracleSelection {
     /// Φ_i / ΣΦ, or `None` when no light emits.
     power_pmf: Option<Vec<f64>>,
 }
 
-/// The oracle's distribution at one shading point: cdf[i] = Σ_{j ≤ i} weight_j (f64, so that a
+/// The oracle's distribution at one shading point: `cdf[i]` = Σ_{j ≤ i} weight_j (f64, so that a
 /// light with a tiny weight keeps a non-zero interval next to bright ones).
 pub struct OracleState {
     cdf: Vec<f64>,
@@ -43,6 +45,7 @@ impl OracleState {
 }
 
 impl OracleSelection {
+    /// The oracle over `scene`'s lights.
     pub fn new(scene: &Scene) -> OracleSelection {
         let power: Vec<f64> = scene.lights.iter().map(|l| l.power() as f64).collect();
         let total: f64 = power.iter().sum();

@@ -52,6 +52,7 @@ impl<T: Scratch> Drop for Pooled<T> {
 }
 
 /// Declares `Scratch` for a type with a thread-local pool.
+#[doc(hidden)]
 #[macro_export]
 macro_rules! scratch_pool {
     ($t:ty, $reset:expr) => {

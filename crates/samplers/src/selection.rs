@@ -10,6 +10,7 @@ use render_core::scene::Scene;
 pub trait LightSelection: Send + Sync {
     /// Per-shading-point state (e.g. a light cut), computed once and shared by `pick` and `pmf`.
     type State;
+    /// The state of shading point `sp`.
     fn prepare(&self, scene: &Scene, sp: &ShadingPoint) -> Self::State;
     /// Number of parts (clusters) the selection splits the lights into at this shading point;
     /// 0 for single-sample selection.
@@ -34,6 +35,7 @@ pub struct UniformSelection {
 }
 
 impl UniformSelection {
+    /// Over `scene`'s lights.
     pub fn new(scene: &Scene) -> Self {
         UniformSelection {
             count: scene.lights.len() as u32,
@@ -65,6 +67,7 @@ pub struct PowerSelection {
 }
 
 impl PowerSelection {
+    /// Over `scene`'s lights, ∝ their power.
     pub fn new(scene: &Scene) -> Self {
         let powers: Vec<f32> = scene.lights.iter().map(|l| l.power()).collect();
         PowerSelection {

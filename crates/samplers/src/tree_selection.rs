@@ -56,12 +56,16 @@ pub enum TreeMode {
     Split(SplitParams),
 }
 
+/// Light-tree selection: one descent, or an E&K adaptive cut with one light per cluster.
 pub struct TreeSelection {
+    /// The tree over the scene's lights (None without lights).
     pub tree: Option<LightTree>,
+    /// Single descent or adaptive splitting.
     pub mode: TreeMode,
 }
 
 impl TreeSelection {
+    /// The tree over `scene`'s lights in `units` of power.
     pub fn new(scene: &Scene, mode: TreeMode, units: PowerUnits) -> Result<TreeSelection, String> {
         let bounds = light_bounds(scene, units);
         let tree = if bounds.is_empty() {

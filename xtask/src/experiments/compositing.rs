@@ -3,24 +3,15 @@
 use super::charts::register_font;
 use glam::Vec3;
 use plotters::prelude::*;
-use render_core::colour::luminance;
 use std::path::Path;
 
-/// Scale that maps the 97th percentile of the luminance of the unlit pixels to 0.9.
+/// Scale that maps the 97th percentile of the luminance of the unlit pixels to 0.9 (1 when no
+/// pixel is unlit): [`render_core::colour::auto_exposure_scale`], as the renderer's previews.
 pub fn auto_exposure(px: &[Vec3], unlit: &[bool]) -> f32 {
-    let mut l: Vec<f32> = px
-        .iter()
-        .zip(unlit)
-        .filter(|(_, u)| **u)
-        .map(|(p, _)| luminance(*p))
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .collect();
-    if l.is_empty() {
+    if !unlit.iter().any(|&u| u) {
         return 1.0;
     }
-    l.sort_by(f32::total_cmp);
-    let p = l[((l.len() - 1) as f32 * 0.97) as usize];
-    if p > 0.0 { 0.9 / p } else { 1.0 }
+    render_core::colour::auto_exposure_scale(px, unlit)
 }
 
 fn srgb(c: f32) -> u8 {

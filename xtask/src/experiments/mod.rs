@@ -10,6 +10,7 @@ pub mod reference;
 pub mod report;
 pub mod run;
 pub mod summary;
+pub mod viewer;
 
 use clap::Parser;
 use config::Experiment;

@@ -1,4 +1,4 @@
-//! Writes results/<experiment>/{cells.csv, cells.json, table.md, plots/, strips/} from the
+//! Writes results/<experiment>/{cells.csv, cells.json, table.md, plots/, strips/, index.html} from the
 //! finished cell files (needs no renderer: `merge-results` runs it too).
 use super::charts::{self, Series};
 use super::compositing::{self, StripColumn};
@@ -31,7 +31,8 @@ fn clock_words(clock: BudgetClock) -> &'static str {
     }
 }
 
-fn budgets(exp: &Experiment) -> Vec<Budget> {
+/// The experiment's budgets: its spp counts, then its time budgets.
+pub fn budgets(exp: &Experiment) -> Vec<Budget> {
     let mut b: Vec<Budget> = exp.spp.iter().map(|&n| Budget::Spp(n)).collect();
     b.extend(exp.time_budgets.iter().map(|&t| Budget::Time(t)));
     b
@@ -121,7 +122,8 @@ pub fn generate(
     write_missing(&mut md, exp, &cells);
     render_core::output::write_atomically(&out.join("table.md"), |tmp| {
         std::fs::write(tmp, &md).map_err(|e| e.to_string())
-    })
+    })?;
+    super::viewer::write(exp, out, refs_dir, &layout.rows, &layout.cols, &cells, &md)
 }
 
 /// cells.csv and cells.json: every finished cell.

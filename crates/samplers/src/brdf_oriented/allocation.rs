@@ -19,6 +19,7 @@ use render_core::estimator::PIXEL_MEMORY;
 
 /// Slots of the pixel memory used by the tallies.
 pub const SLOT_HITS: usize = 0;
+/// Slot of the BRDF-sampling misses (see [`SLOT_HITS`]).
 pub const SLOT_MISSES: usize = 1;
 /// Slots of the efficiency tally ([`EfficiencyTally`]).
 const SLOT_SAMPLES: usize = 2;
@@ -144,12 +145,16 @@ pub fn fixed_counts(n: u32, p_bo: f32) -> (u32, u32) {
 /// The authors' sequential counters (`reproduce`).
 #[derive(Clone, Copy, Debug)]
 pub struct InSampleCounters {
+    /// BRDF samples that found no light, plus the prior 1.
     pub fail: f32,
+    /// λ × BRDF samples that found a light, plus the prior 1.
     pub success: f32,
+    /// Weight λ of a hit.
     pub lambda: f32,
 }
 
 impl InSampleCounters {
+    /// Counters at the authors' priors (1, 1).
     pub fn new(lambda: f32) -> Self {
         InSampleCounters {
             fail: 1.0,
@@ -157,6 +162,7 @@ impl InSampleCounters {
             lambda,
         }
     }
+    /// Counts one BRDF sample's outcome.
     pub fn record(&mut self, hit: bool) {
         if hit {
             self.success += self.lambda;
@@ -164,6 +170,7 @@ impl InSampleCounters {
             self.fail += 1.0;
         }
     }
+    /// P(BO) = n_nohit / (n_nohit + λ·n_hit).
     pub fn p_bo(&self) -> f32 {
         self.fail / (self.fail + self.success)
     }

@@ -16,9 +16,11 @@ pub struct BoCutScratch {
 /// A BO cut: node ids sorted by DFS id with their terms and the cumulative importance.
 #[derive(Clone, Debug, Default)]
 pub struct BoCut {
+    /// The cut's nodes (sorted by DFS id).
     pub cut: Cut,
+    /// Each node's BO terms (I_BO and cap integral), in the cut's order.
     pub terms: Vec<NodeTerms>,
-    /// cdf[k] = Σ_{j ≤ k} I_BO(cut node j).
+    /// `cdf[k]` = Σ_{j ≤ k} I_BO(cut node j).
     pub cdf: Vec<f32>,
 }
 
@@ -85,6 +87,7 @@ impl BoCut {
         }
     }
 
+    /// Σ I_BO over the cut (0: BO cannot sample here).
     pub fn total(&self) -> f32 {
         self.cdf.last().copied().unwrap_or(0.0)
     }

@@ -21,7 +21,9 @@ use std::f32::consts::PI;
 /// What the BO importance needs of a shading point; built once per shading point.
 #[derive(Clone, Copy, Debug)]
 pub struct BoRecord<L> {
+    /// The shading position.
     pub x: Vec3,
+    /// The shading frame (z = normal, x = ωo projected).
     pub frame: Frame,
     /// The glossy lobe's cap integral (SPTD or LTC), un-Fresnelled, without Ks.
     pub lobe: L,
@@ -67,7 +69,9 @@ pub struct NodeTerms {
 /// The approximate lobe's density g(ω) (∫_cap g ≈ the cap integral) and its peak direction
 /// and angular width, where the approximation has them.
 pub trait LobeDensity {
+    /// g(ω) for a local direction `w` (None where the method has no density).
     fn density(&self, w: Vec3) -> Option<f32>;
+    /// The peak direction (local) and angular width in radians.
     fn peak(&self) -> Option<(Vec3, f32)>;
 }
 
@@ -94,13 +98,21 @@ impl LobeDensity for brdf_integrals::LtcLobe {
 }
 
 impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
-    pub fn new(sp: &ShadingPoint, lobe: L, diffuse_term: bool, oat_sander: bool) -> Self {
-        let p = &sp.bsdf.params;
-        let weight = if diffuse_term {
-            sp.bsdf.glossy_weight(sp.bsdf.frame.to_local(sp.wo))
-        } else {
-            p.specular.tint()
-        };
+    /// A record from raw inputs, for a renderer other than ours: the shading position `x`, its
+    /// shading `frame` (z = normal, x = ωo projected, as the lobe's tables expect), the glossy
+    /// `lobe` (`brdf_integrals::CapIntegral::lobe` for ωo in that frame and GGX α), the
+    /// luminances of the glossy lobe's weight `ks` (0 for a pure diffuse point) and of the
+    /// diffuse albedo `kd`. `diffuse_term` adds Kd/π × projected solid angle to I_BO (our
+    /// default); `oat_sander` takes the authors' approximate |cap ∩ H| (and no point estimate).
+    pub fn from_parts(
+        x: Vec3,
+        frame: Frame,
+        lobe: L,
+        ks: f32,
+        kd: f32,
+        diffuse_term: bool,
+        oat_sander: bool,
+    ) -> Self {
         let peak = lobe.peak().map(|(dir, width)| PeakBound {
             dir,
             width,
@@ -110,18 +122,38 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
         BoRecord {
             peak,
             point_approx: !oat_sander,
-            x: sp.point(),
-            frame: sp.bsdf.frame,
+            x,
+            frame,
             lobe,
-            ks: if sp.bsdf.is_pure_diffuse() {
-                0.0
-            } else {
-                luminance(weight).max(0.0)
-            },
-            kd: luminance(p.diffuse).max(0.0),
+            ks: ks.max(0.0),
+            kd: kd.max(0.0),
             diffuse_term,
             oat_sander,
         }
+    }
+
+    /// The record of our renderer's shading point `sp` (its BSDF gives the frame, `ks`, `kd`).
+    pub fn new(sp: &ShadingPoint, lobe: L, diffuse_term: bool, oat_sander: bool) -> Self {
+        let p = &sp.bsdf.params;
+        let weight = if diffuse_term {
+            sp.bsdf.glossy_weight(sp.bsdf.frame.to_local(sp.wo))
+        } else {
+            p.specular.tint()
+        };
+        let ks = if sp.bsdf.is_pure_diffuse() {
+            0.0
+        } else {
+            luminance(weight).max(0.0)
+        };
+        Self::from_parts(
+            sp.point(),
+            sp.bsdf.frame,
+            lobe,
+            ks,
+            luminance(p.diffuse).max(0.0),
+            diffuse_term,
+            oat_sander,
+        )
     }
 
     /// BO terms of `node`.

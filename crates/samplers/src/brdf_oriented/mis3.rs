@@ -25,6 +25,7 @@ use render_core::scene::Scene;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, Ordering};
 
+/// Which of the method's strategies a [`Mis3`] is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Mis3Mode {
     /// BO alone: one BO sample. **Not a complete estimator**: the SPTD/LTC approximation (and,
@@ -37,11 +38,17 @@ pub enum Mis3Mode {
     Adaptive,
 }
 
+/// The strategies `brdf-oriented`, `mis3-equal` and `mis3-adaptive` (Liu, Xu & Yan 2019).
 pub struct Mis3<C: CapIntegral> {
+    /// The strategy's registered name.
     pub name: String,
+    /// BO alone, equal counts, or the adaptive allocation.
     pub mode: Mis3Mode,
+    /// The light tree and the LS technique (E&K cut or one descent).
     pub ls: TreeSelection,
+    /// The cap-integral method behind BO.
     pub integral: C,
+    /// The method's knobs.
     pub config: BoConfig,
     /// Heuristic 1's N_max for the next pass (f32 bits): `config.n_max`, or with
     /// `efficient_total` what [`EfficiencyTally::best_n_max`] chose after the last pass.
@@ -97,6 +104,7 @@ where
 }
 
 impl<C: CapIntegral> Mis3<C> {
+    /// The strategy `name` in `mode` over the light tree of `ls`.
     pub fn new(
         name: String,
         mode: Mis3Mode,

@@ -24,12 +24,15 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum BrdfIntegral {
+    /// Spherical pivot-transformed distributions (the authors' choice).
     #[default]
     Sptd,
+    /// Linearly transformed cosines (Heitz et al. 2016).
     Ltc,
 }
 
 impl BrdfIntegral {
+    /// Every method, in the order `--help` lists them.
     pub const ALL: [BrdfIntegral; 2] = [BrdfIntegral::Sptd, BrdfIntegral::Ltc];
 
     /// The name on the command line and in the render's JSON.
@@ -60,14 +63,23 @@ impl std::str::FromStr for BrdfIntegral {
 /// Knobs of the method (recorded in the render's JSON).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BoConfig {
+    /// BO cut: split a node whose cap integral exceeds δ.
     pub delta: f32,
+    /// Heuristic 1's N_max (BRDF-aware samples beyond the forced two).
     pub n_max: u32,
+    /// Weight λ of a BRDF-sampling hit in P(BO).
     pub lambda: f32,
+    /// The LS cut's splitting threshold τ.
     pub tau: f32,
+    /// Most clusters in the LS cut.
     pub max_cut: usize,
+    /// Most clusters in the BO cut.
     pub max_cut_bo: usize,
+    /// Cap-integral approximation behind BO.
     pub brdf_integral: BrdfIntegral,
+    /// The authors' code's behaviour throughout.
     pub reproduce: bool,
+    /// Pivot-sphere point sampling on sphere lights.
     pub pivot_sphere: bool,
     /// Heuristic 1 (N from UB); off: N = N_max/2.
     pub adaptive_total: bool,
@@ -86,6 +98,7 @@ pub struct BoConfig {
 
 /// The SPTD pivot of a lobe, where the approximation has one.
 pub trait LobePivot {
+    /// The pivot in the lobe's local frame (None for methods without one).
     fn pivot(&self) -> Option<Vec3>;
 }
 

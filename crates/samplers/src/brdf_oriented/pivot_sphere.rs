@@ -15,6 +15,7 @@ use render_core::{Vec2, Vec3};
 /// Probability of the pivot sampler in the mixture.
 pub const PIVOT_FRACTION: f32 = 0.5;
 
+/// Point sampling on sphere lights by the pivot-transformed lobe, mixed with cone sampling.
 #[derive(Clone, Copy, Debug)]
 pub struct PivotSphere {
     /// The SPTD pivot in the BSDF's local frame.
@@ -34,6 +35,8 @@ fn local_cap<L>(rec: &BoRecord<L>, center: Vec3, radius: f32) -> Option<(Cap, f3
 }
 
 impl PivotSphere {
+    /// A point on `light` seen from the record's shading point (cone sampling for lights that
+    /// are not spheres); [`PivotSphere::pdf`] is its density.
     pub fn sample<L>(
         &self,
         rec: &BoRecord<L>,

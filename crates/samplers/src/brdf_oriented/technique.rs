@@ -27,6 +27,7 @@ crate::scratch_pool!(BoScratch, |s| s.memo.get_mut().invalidate());
 /// memoised node importances shared by sampling and pdf evaluation. Its buffers are on loan
 /// from a per-thread pool (no allocation per shading point).
 pub struct BoState<L> {
+    /// The shading point's record.
     pub rec: BoRecord<L>,
     scratch: Pooled<BoScratch>,
     /// Pivot-sphere point sampling (method.md §3.1), if enabled.
@@ -89,15 +90,31 @@ impl<L: LobeIntegral + LobeDensity> BoState<L> {
         rng: &mut SampleStream,
         fresh: bool,
     ) -> Option<(usize, f32)> {
+        if fresh {
+            self.select_from(tree, u_cluster, || rng.next_f32())
+        } else {
+            let cut = self.cut();
+            let (k, p_cl, _) = cut.pick(u_cluster)?;
+            let imp = |c| self.importance(tree, c);
+            let (light, p) =
+                tree.sample_subtree(cut.cut.nodes[k], imp, &mut Rescaled(rng.next_f32()))?;
+            Some((light, p_cl * p))
+        }
+    }
+
+    /// [`BoState::select_with`] with a fresh number per tree level from `next` (uniform in
+    /// [0, 1)), any source of random numbers: `(light, selection probability)`, the
+    /// probability [`BoState::selection_pmf`] gives for that light.
+    pub fn select_from(
+        &self,
+        tree: &LightTree,
+        u_cluster: f32,
+        next: impl FnMut() -> f32,
+    ) -> Option<(usize, f32)> {
         let cut = self.cut();
         let (k, p_cl, _) = cut.pick(u_cluster)?;
-        let start = cut.cut.nodes[k];
         let imp = |c| self.importance(tree, c);
-        let (light, p) = if fresh {
-            tree.sample_subtree(start, imp, &mut Fresh(|| rng.next_f32()))?
-        } else {
-            tree.sample_subtree(start, imp, &mut Rescaled(rng.next_f32()))?
-        };
+        let (light, p) = tree.sample_subtree(cut.cut.nodes[k], imp, &mut Fresh(next))?;
         Some((light, p_cl * p))
     }
 

@@ -14,29 +14,41 @@ use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::{Vec2, Vec3};
 
+/// Index of tree-splitting light sampling in [`Taken::p`] and the technique counters.
 pub const TECHNIQUE_LS: usize = 0;
+/// Index of BRDF-oriented light sampling.
 pub const TECHNIQUE_BO: usize = 1;
+/// Index of BRDF sampling.
 pub const TECHNIQUE_BSDF: usize = 2;
 
 /// A sample with a non-zero unweighted contribution: technique, f·L (shadowed), and the densities
 /// of the three techniques at its light point.
 #[derive(Clone, Copy, Debug)]
 pub struct Taken {
+    /// The technique that drew it ([`TECHNIQUE_LS`], [`TECHNIQUE_BO`], [`TECHNIQUE_BSDF`]).
     pub tech: usize,
     /// The sample's index among its technique's samples at this shading point.
     pub index: u32,
+    /// f·L·G with visibility, unweighted.
     pub f: Vec3,
+    /// The three techniques' densities at its light point (solid angle × selection).
     pub p: [f32; 3],
 }
 
 /// One shading point with both cuts made: the LS state (E&K cut or one descent) and, at a
 /// glossy point, the BO state (BO cut and its record).
 pub struct PointTechniques<'a, L> {
+    /// The scene (lights and occlusion).
     pub scene: &'a Scene,
+    /// The shading point.
     pub sp: &'a ShadingPoint,
+    /// The light tree both cuts are of.
     pub tree: &'a LightTree,
+    /// The LS technique.
     pub ls: &'a TreeSelection,
+    /// The LS cut of this point.
     pub ls_state: TreeState,
+    /// The BO state, at glossy points.
     pub bo: Option<BoState<L>>,
     /// BO's descent takes a fresh random number per tree level (off: the authors' rescaled one).
     pub fresh: bool,

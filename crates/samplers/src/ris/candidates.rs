@@ -28,13 +28,17 @@ pub struct CandidateSource<'a, L> {
     /// The tree importances of this shading point, memoised (shared by draws and replays).
     memo: RefCell<Pooled<NodeMemo>>,
     bo: Option<&'a BoState<L>>,
+    /// Candidates drawn by LS.
     pub n_ls: u32,
+    /// Candidates drawn by BO.
     pub n_bo: u32,
 }
 
 /// A drawn light point and the technique's selection probability of its light.
 pub struct Drawn {
+    /// The light's index in the scene.
     pub light: u32,
+    /// The point on it.
     pub sample: LightSample,
 }
 
@@ -60,6 +64,7 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
         }
     }
 
+    /// Candidates in all (M).
     pub fn count(&self) -> u32 {
         self.n_ls + self.n_bo
     }

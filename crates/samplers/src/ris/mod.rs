@@ -17,12 +17,15 @@ use serde::Serialize;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum CandidateCount {
+    /// M candidates at every shading point.
     Fixed(u32),
     /// M = min + round((max − min)·UB), UB the BO cut's largest cap integral (the paper's
     /// heuristic 1: sharp lobes facing bright clusters get more candidates); `min` where the
     /// point has no BO cut (pure diffuse).
     Adaptive {
+        /// M at UB = 0 (and at pure diffuse points).
         min: u32,
+        /// M at UB = 1.
         max: u32,
     },
 }

@@ -38,17 +38,27 @@ use render_core::light::LightSample;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 
+/// Index of the candidates drawn in the technique counters.
 pub const TECHNIQUE_CANDIDATES: usize = 0;
+/// Index of the resampled light sample.
 pub const TECHNIQUE_RIS: usize = 1;
+/// Index of BSDF sampling.
 pub const TECHNIQUE_BSDF: usize = 2;
 
+/// The strategies `ris`, `ris-N`, `ris-adaptive`: resampled importance sampling of light
+/// candidates, combined with BSDF sampling.
 pub struct Ris<C: CapIntegral> {
+    /// The strategy's registered name.
     pub name: String,
+    /// The light tree (None without lights).
     pub tree: Option<LightTree>,
+    /// The cap-integral method behind the BO candidates.
     pub integral: C,
+    /// How many candidates.
     pub count: CandidateCount,
     /// BO cut: split threshold δ and most clusters.
     pub delta: f32,
+    /// Most clusters of the BO cut.
     pub max_cut: usize,
 }
 
