@@ -94,9 +94,9 @@ impl<L: LobeIntegral + LobeDensity> BoState<L> {
         let start = cut.cut.nodes[k];
         let imp = |c| self.importance(tree, c);
         let (light, p) = if fresh {
-            tree.sample_subtree(start, imp, &mut Fresh(|| rng.next_f32()))?
+            tree.sample_subtree(start, imp, &mut Fresh(|| rng.next_u64()))?
         } else {
-            tree.sample_subtree(start, imp, &mut Rescaled(rng.next_f32()))?
+            tree.sample_subtree(start, imp, &mut Rescaled(rng.next_u64()))?
         };
         Some((light, p_cl * p))
     }
