@@ -16,6 +16,7 @@ pub mod colour;
 pub mod error;
 pub mod estimator;
 pub mod frame;
+mod hash;
 pub mod light;
 pub mod material;
 pub mod metrics;

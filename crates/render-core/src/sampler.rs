@@ -94,12 +94,12 @@ fn sobol_second(mut index: u32) -> u32 {
 #[inline]
 pub fn sobol_value(pixel_key: u64, index: u32, dim: u32) -> u32 {
     let pair =
-        crate::rng::mix64(pixel_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93));
+        crate::hash::mix64(pixel_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93));
     let shuffled = owen_scramble(index, pair as u32);
     let (raw, scramble) = if dim % 2 == 0 {
         (shuffled.reverse_bits(), (pair >> 32) as u32)
     } else {
-        (sobol_second(shuffled), crate::rng::mix64(pair) as u32)
+        (sobol_second(shuffled), crate::hash::mix64(pair) as u32)
     };
     owen_scramble(raw, scramble)
 }
