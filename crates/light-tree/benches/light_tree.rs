@@ -67,14 +67,16 @@ fn lights(n: usize) -> Vec<LightBounds> {
         .collect()
 }
 
-fn queries() -> Vec<(Vec3, Vec3, f32)> {
+/// Receivers and the descents' 64 random bits (made of an f32 draw, so that the queries are
+/// those of the benchmark's f32 days).
+fn queries() -> Vec<(Vec3, Vec3, u64)> {
     let mut rng = Pcg32::seed_from_u64(99);
     (0..QUERIES)
         .map(|_| {
             (
                 rand_point(&mut rng),
                 rand_dir(&mut rng),
-                rng.random::<f32>(),
+                (rng.random::<f32>() as f64 * 18_446_744_073_709_551_616.0) as u64,
             )
         })
         .collect()

@@ -76,10 +76,10 @@ fn main() {
         }
         let tree = tree.unwrap();
         let mut rng = rand_pcg::Pcg32::seed_from_u64(7);
-        let qs: Vec<(Vec3, Vec3, f32)> = (0..200_000)
+        let qs: Vec<(Vec3, Vec3, u64)> = (0..200_000)
             .map(|_| {
                 let x = Vec3::new(rng.random(), rng.random(), rng.random()) * 100.0;
-                (x, rand_dir(&mut rng), rng.random::<f32>())
+                (x, rand_dir(&mut rng), rng.random::<u64>())
             })
             .collect();
         let (mut sp, mut spc) = (Vec::new(), Vec::new());

@@ -52,8 +52,8 @@
 //! let tree = LightTree::build(&lights).expect("valid bounds");
 //! assert_eq!(tree.num_lights(), 3);
 //!
-//! // Shading point at the origin on a floor facing +z; `u` is one uniform number in [0, 1).
-//! let (x, n, u) = (Vec3::ZERO, Vec3::Z, 0.37);
+//! // Shading point at the origin on a floor facing +z; `u` is 64 uniform random bits.
+//! let (x, n, u) = (Vec3::ZERO, Vec3::Z, 0x5eb8_51eb_851e_b851);
 //! let (light, pmf) = tree.sample(x, n, u).expect("every light can reach x");
 //! assert!(light < lights.len() && pmf > 0.0 && pmf <= 1.0);
 //! // The pmf can be recomputed for any light (e.g. for MIS), bit for bit.

@@ -4,8 +4,6 @@ use crate::{LightTree, Node, NodeId};
 use glam::Vec3;
 use std::collections::VecDeque;
 
-/// Largest f32 below 1.
-const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 /// Floor of the squared distance in the importance: keeps Φ/d² finite when x sits exactly on
 /// a point light (r = 0).
 const MIN_DIST_SQ: f32 = 1e-12;
@@ -16,46 +14,58 @@ const MIN_EMIT_COS: f32 = 1e-3;
 /// Source of the random decisions in a descent.
 ///
 /// Implement it to drive [`LightTree::sample_subtree`] with your own sampler; [`Rescaled`]
-/// and [`Fresh`] are the two ready-made choices.
+/// and [`Fresh`] are the two ready-made choices, both from 64 random bits.
 pub trait DescentRandom {
-    /// Returns `true` (go left) with probability `p_left`, `0 < p_left < 1`.
+    /// Returns `true` (go left) with probability `p_left`, `0 < p_left ≤ 1`.
     fn go_left(&mut self, p_left: f32) -> bool;
 }
 
-/// One uniform number in [0, 1) rescaled at every level (E&K / pbrt-v4 style). Loses about
-/// one bit of precision per level.
+/// 2⁶⁴ · `p` as an integer: 64 uniform bits fall below it with probability `p` (to 2⁻⁶⁴).
+/// Exact for p ≥ 2⁻⁴¹ (an f32 has 24 significant bits), truncated below; p = 1 saturates at
+/// 2⁶⁴ − 1.
+#[inline]
+fn threshold(p: f32) -> u64 {
+    (p as f64 * 18_446_744_073_709_551_616.0) as u64
+}
+
+/// One 64-bit uniform number rescaled at every level (E&K / pbrt-v4 style, in fixed point):
+/// at a node with left probability p, go left when u < t = 2⁶⁴p and continue with
+/// ⌊2⁶⁴u/t⌋, else with ⌊2⁶⁴(u − t)/(2⁶⁴ − t)⌋. A decision of probability p uses up log₂(1/p)
+/// of the 64 bits, so a descent to a light of probability P keeps 64 − log₂(1/P) bits for
+/// the levels below (an f32 kept 24 − log₂(1/P): none at 2²⁴ lights).
 #[derive(Clone, Copy, Debug)]
 pub struct Rescaled(
-    /// The current uniform number in [0, 1), rescaled in place after every decision.
-    pub f32,
+    /// The current uniform number in [0, 2⁶⁴), rescaled in place after every decision.
+    pub u64,
 );
 
 impl DescentRandom for Rescaled {
     #[inline]
     fn go_left(&mut self, p_left: f32) -> bool {
-        let u = self.0;
-        if u < p_left {
-            self.0 = (u / p_left).min(ONE_MINUS_EPSILON);
+        const ONE: u128 = 1 << 64;
+        let (u, t) = (self.0 as u128, threshold(p_left) as u128);
+        // Both quotients are below 2⁶⁴: u < t on the left, u − t < 2⁶⁴ − t on the right.
+        if u < t {
+            self.0 = ((u << 64) / t) as u64;
             true
         } else {
-            self.0 = ((u - p_left) / (1.0 - p_left)).min(ONE_MINUS_EPSILON);
+            self.0 = (((u - t) << 64) / (ONE - t)) as u64;
             false
         }
     }
 }
 
-/// A fresh uniform number in [0, 1) per level (Liu et al.'s improvement), drawn from the
-/// wrapped closure.
-pub struct Fresh<F: FnMut() -> f32>(
+/// 64 fresh random bits per level (Liu et al.'s improvement), drawn from the wrapped closure.
+pub struct Fresh<F: FnMut() -> u64>(
     /// Called once per random decision (an interior node whose two children both have
-    /// non-zero importance); must return independent uniform numbers in [0, 1).
+    /// non-zero importance); must return independent uniform 64-bit numbers.
     pub F,
 );
 
-impl<F: FnMut() -> f32> DescentRandom for Fresh<F> {
+impl<F: FnMut() -> u64> DescentRandom for Fresh<F> {
     #[inline]
     fn go_left(&mut self, p_left: f32) -> bool {
-        (self.0)() < p_left
+        (self.0)() < threshold(p_left)
     }
 }
 
@@ -331,7 +341,8 @@ impl LightTree {
         self.nodes[node as usize].importance(x, n)
     }
 
-    /// Samples one light by a single descent from the root with one rescaled `u` ∈ [0, 1).
+    /// Samples one light by a single descent from the root with one rescaled 64-bit uniform
+    /// `u` (see [`Rescaled`]).
     /// Returns `(light, pmf)`, or `None` when the descent reaches a node whose children
     /// both have zero importance (with conservative bounds those lights cannot reach `x`).
     ///
@@ -339,7 +350,7 @@ impl LightTree {
     /// probability of that choice (not a density), equal to [`LightTree::pmf`] for it. `x` and
     /// `n` are as in [`LightTree::importance`].
     #[inline]
-    pub fn sample(&self, x: Vec3, n: Vec3, u: f32) -> Option<(usize, f32)> {
+    pub fn sample(&self, x: Vec3, n: Vec3, u: u64) -> Option<(usize, f32)> {
         self.sample_subtree(
             self.root(),
             |id| self.importance(id, x, n),

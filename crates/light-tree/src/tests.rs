@@ -324,7 +324,7 @@ fn pmf_sums_to_one_and_matches_sample() {
                     assert!((sum - (1.0 - dead)).abs() < 1e-5);
                 }
                 for _ in 0..20 {
-                    let u = rng.random::<f32>();
+                    let u = rng.random::<u64>();
                     match tree.sample(x, nrm, u) {
                         Some((l, p)) => {
                             assert!(p > 0.0);
@@ -364,7 +364,7 @@ fn sample_frequencies_pass_chi2() {
             let (x, nrm) = rand_receiver(&mut rng);
             let mut observed = vec![0u64; n + 1];
             for _ in 0..samples {
-                match tree.sample(x, nrm, rng.random::<f32>()) {
+                match tree.sample(x, nrm, rng.random::<u64>()) {
                     Some((l, _)) => observed[l] += 1,
                     None => observed[n] += 1,
                 }
@@ -437,12 +437,12 @@ fn subtree_descent_with_both_random_sources() {
             for fresh in [false, true] {
                 let mut observed = vec![0u64; tree.num_lights() + 1];
                 let mut r2 = Pcg32::seed_from_u64(rng.random());
-                let mut fresh_src = Fresh(|| r2.random::<f32>());
+                let mut fresh_src = Fresh(|| r2.random::<u64>());
                 for _ in 0..samples {
                     let s = if fresh {
                         tree.sample_subtree(start, imp, &mut fresh_src)
                     } else {
-                        tree.sample_subtree(start, imp, &mut Rescaled(rng.random::<f32>()))
+                        tree.sample_subtree(start, imp, &mut Rescaled(rng.random::<u64>()))
                     };
                     match s {
                         Some((l, p)) => {
@@ -609,7 +609,7 @@ fn depth_is_bounded_on_adversarial_input() {
             .sum();
         assert!((sum - 1.0).abs() < 1e-5, "sum {sum}");
         for i in 0..200 {
-            let u = (i as f32 + 0.5) / 200.0;
+            let u = ((i as f64 + 0.5) / 200.0 * 18_446_744_073_709_551_616.0) as u64;
             let (l, p) = tree
                 .sample_subtree(tree.root(), imp, &mut Rescaled(u))
                 .unwrap();
@@ -711,7 +711,7 @@ fn all_dark_receiver() {
     let tree = LightTree::build(&lights).unwrap();
     let x = Vec3::new(0.0, 0.0, 1.0);
     for n in [Vec3::Z, Vec3::ZERO] {
-        assert!(tree.sample(x, n, 0.3).is_none());
+        assert!(tree.sample(x, n, 1 << 62).is_none());
         assert!((0..30).all(|l| tree.pmf(x, n, l) == 0.0));
     }
     // Facing the receiver instead, everything is lit.
@@ -790,5 +790,79 @@ fn tree_beats_power_sampling_on_spread_lights() {
     assert!(
         var_tree * 5.0 < var_power,
         "tree {var_tree} power {var_power}"
+    );
+}
+
+/// splitmix64: 64 independent-looking bits per call, for the many-sample tests below.
+fn splitmix(state: &mut u64) -> u64 {
+    *state = state.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    let mut z = *state;
+    z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    z ^ (z >> 31)
+}
+
+/// At 2²⁰ lights a descent decides 20 times. With one number rescaled down the levels, each
+/// decision uses up the bits the ones above it consumed; with only 24 of them, every leaf's
+/// realised probability was a multiple of 2⁻²⁴ (about 16 quanta per leaf here), off the pmf by
+/// a few per cent (this test gave p = 5·10⁻²²). 2²⁴ descents, a chi-square test over the
+/// leaves against the exact (f64) distribution of the descent: it must not reject at 0.1 %.
+#[test]
+fn deep_descent_frequencies_match_the_pmf_at_2_pow_20_lights() {
+    let n = 1usize << 20;
+    let lights: Vec<LightBounds> = (0..n)
+        .map(|i| LightBounds::point(Vec3::new((i % 1024) as f32, (i / 1024) as f32, 0.0), 1.0))
+        .collect();
+    let tree = LightTree::build(&lights).unwrap();
+    assert!(tree.max_depth() >= 20, "depth {}", tree.max_depth());
+    // Importances in [1, 2): every p_left in [1/3, 2/3], almost never a dyadic fraction (on
+    // which a float rescale is exact).
+    let imp = |id: NodeId| {
+        let h = (id as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        let h = (h ^ (h >> 29)).wrapping_mul(0xBF58_476D_1CE4_E5B9) >> 40;
+        1.0 + (h % 4096) as f32 / 4096.0
+    };
+    let (reference, dead) = reference_pmf(&tree, tree.root(), &imp);
+    assert_eq!(dead, 0.0);
+    // Sixteen fixed chunks of 2²⁰ descents, each from its own seed, on threads of their own (the
+    // counts do not depend on the scheduling).
+    let chunks = 16u64;
+    let samples = chunks << 20;
+    let parts: Vec<Vec<u32>> = std::thread::scope(|s| {
+        let handles: Vec<_> = (0..chunks)
+            .map(|c| {
+                let (tree, imp) = (&tree, &imp);
+                s.spawn(move || {
+                    let mut observed = vec![0u32; n];
+                    let mut state = 20 + c;
+                    for _ in 0..1 << 20 {
+                        let mut u = Rescaled(splitmix(&mut state));
+                        let (l, _) = tree.sample_subtree(tree.root(), imp, &mut u).unwrap();
+                        observed[l] += 1;
+                    }
+                    observed
+                })
+            })
+            .collect();
+        handles.into_iter().map(|h| h.join().unwrap()).collect()
+    });
+    let observed: Vec<f64> = (0..n)
+        .map(|l| parts.iter().map(|p| p[l] as f64).sum())
+        .collect();
+    let expected: Vec<f64> = reference.iter().map(|p| p * samples as f64).collect();
+    let r = chi2_test(&observed, &expected);
+    eprintln!(
+        "2^20 lights, depth {}: chi2 {} dof {} p {}",
+        tree.max_depth(),
+        r.statistic,
+        r.dof,
+        r.p_value
+    );
+    assert!(
+        r.p_value > 1e-3,
+        "chi2 {} dof {} p {}",
+        r.statistic,
+        r.dof,
+        r.p_value
     );
 }

@@ -17,6 +17,7 @@ pub mod error;
 pub mod estimator;
 pub mod filter;
 pub mod frame;
+mod hash;
 pub mod light;
 pub mod material;
 pub mod metrics;

@@ -1,6 +1,7 @@
 //! Counter-based random numbers: the value of a dimension depends only on
 //! (seed, pixel, sample index, dimension), never on thread scheduling, so an image is
 //! bit-identical whatever the thread count. Which value that is, the [`Sampler`] decides.
+use crate::hash::mix64;
 use crate::sampler::{SamplePosition, Sampler};
 use crate::zsobol::ZOrder;
 
@@ -12,14 +13,6 @@ pub struct SampleStream {
     sampler: Sampler,
     /// Where the sample sits, for the samplers other than `independent`.
     at: SamplePosition,
-}
-
-#[inline]
-pub(crate) fn mix64(mut z: u64) -> u64 {
-    // splitmix64 finaliser: a bijective avalanche mix.
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 impl SampleStream {

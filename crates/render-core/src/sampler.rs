@@ -29,6 +29,7 @@
 //! stratified ones the samples of one pixel are correlated with each other, and a strategy that
 //! learns from a pixel's earlier samples (heuristic 2's hit tallies, N_max per pass) learns from
 //! numbers correlated with the later ones; the convergence tests check that the images agree.
+pub use crate::hash::owen_scramble;
 use serde::{Deserialize, Serialize};
 
 /// Which sequence a render's numbers come from.
@@ -121,27 +122,6 @@ pub(crate) struct SamplePosition {
     pub z: crate::zsobol::ZOrder,
 }
 
-/// Laine and Karras's permutation as Burley gives it: every output bit depends only on the
-/// input bits below it (additions carry upwards; products with even constants shift up), and
-/// the map is a bijection.
-#[inline]
-fn laine_karras(mut x: u32, seed: u32) -> u32 {
-    x = x.wrapping_add(seed);
-    x ^= x.wrapping_mul(0x6c50_b47c);
-    x ^= x.wrapping_mul(0xb82f_1e52);
-    x ^= x.wrapping_mul(0xc7af_e638);
-    x ^= x.wrapping_mul(0x8d22_f6e6);
-    x
-}
-
-/// Owen scrambling of `x` read as a binary fraction (most significant bit first): each bit is
-/// flipped by a hash of the bits above it. The first 2^m integers map onto one aligned block of
-/// 2^m integers.
-#[inline]
-pub fn owen_scramble(x: u32, seed: u32) -> u32 {
-    laine_karras(x.reverse_bits(), seed).reverse_bits()
-}
-
 /// The second Sobol dimension (primitive polynomial x + 1, direction numbers all 1), as a
 /// 32-bit fraction.
 #[inline]
@@ -160,7 +140,7 @@ fn sobol_second(mut index: u32) -> u32 {
 /// The hash of one dimension pair of one pixel, from which its shuffle and scrambles come.
 #[inline]
 fn pair_hash(pixel_key: u64, dim: u32) -> u64 {
-    crate::rng::mix64(pixel_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93))
+    crate::hash::mix64(pixel_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xd6e8_feb8_6659_fd93))
 }
 
 /// The unscrambled Sobol coordinate of dimension `dim`'s pair at the shuffled index, and the
@@ -172,7 +152,7 @@ fn shuffled_sobol(pixel_key: u64, index: u32, dim: u32) -> (u32, u32) {
     if dim % 2 == 0 {
         (shuffled.reverse_bits(), (pair >> 32) as u32)
     } else {
-        (sobol_second(shuffled), crate::rng::mix64(pair) as u32)
+        (sobol_second(shuffled), crate::hash::mix64(pair) as u32)
     }
 }
 
@@ -206,7 +186,7 @@ fn permute_below(i: u32, n: u32, seed: u64) -> u32 {
     loop {
         let mut key = seed;
         for _ in 0..4 {
-            key = crate::rng::mix64(key);
+            key = crate::hash::mix64(key);
             x = ((x ^ key as u32) & mask).wrapping_mul((key >> 32) as u32 | 1) & mask;
             x ^= x >> shift;
         }

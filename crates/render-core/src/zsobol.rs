@@ -10,8 +10,8 @@
 //! The sample count is fixed in advance (rounded up to a power of two for the index layout);
 //! each value is a function of (seed, pixel, sample index, dimension) alone, as for every
 //! sampler.
-use crate::rng::mix64;
-use crate::sampler::owen_scramble;
+use crate::hash::mix64;
+use crate::hash::owen_scramble;
 
 /// Where one pixel sample sits in the image's sequence.
 #[derive(Clone, Copy, Debug, Default)]

@@ -64,7 +64,7 @@ pub fn run(n_lights: usize, samples: usize, seed: u64) -> Outcome {
     let mut counts = vec![0.0f64; n_lights];
     for _ in 0..samples {
         let u = rng.random::<f32>();
-        if let Some((light, p)) = state.select_from(&tree, u, || rng.random::<f32>()) {
+        if let Some((light, p)) = state.select_from(&tree, u, || rng.random::<u64>()) {
             // the probability reported at sampling is the one the pmf gives later (MIS needs it)
             let q = state.selection_pmf(&tree, light);
             assert!((p - q).abs() <= 1e-5 * q.max(1e-30), "{p} vs {q}");

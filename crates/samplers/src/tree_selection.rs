@@ -170,7 +170,7 @@ impl LightSelection for TreeSelection {
             None => {
                 let root = tree.root();
                 if let Some((light, pmf)) =
-                    tree.sample_subtree(root, imp, &mut Rescaled(rng.next_f32()))
+                    tree.sample_subtree(root, imp, &mut Rescaled(rng.next_u64()))
                 {
                     picks.push((light as u32, pmf));
                 }
@@ -179,7 +179,7 @@ impl LightSelection for TreeSelection {
                 // One fresh random number per cluster, rescaled down its subtree (as E&K and
                 // the authors' code).
                 for &node in &cut.nodes {
-                    let mut u = Rescaled(rng.next_f32());
+                    let mut u = Rescaled(rng.next_u64());
                     if let Some((light, pmf)) = tree.sample_subtree(node, imp, &mut u) {
                         picks.push((light as u32, pmf));
                     }

@@ -91,25 +91,25 @@ impl<L: LobeIntegral + LobeDensity> BoState<L> {
         fresh: bool,
     ) -> Option<(usize, f32)> {
         if fresh {
-            self.select_from(tree, u_cluster, || rng.next_f32())
+            self.select_from(tree, u_cluster, || rng.next_u64())
         } else {
             let cut = self.cut();
             let (k, p_cl, _) = cut.pick(u_cluster)?;
             let imp = |c| self.importance(tree, c);
             let (light, p) =
-                tree.sample_subtree(cut.cut.nodes[k], imp, &mut Rescaled(rng.next_f32()))?;
+                tree.sample_subtree(cut.cut.nodes[k], imp, &mut Rescaled(rng.next_u64()))?;
             Some((light, p_cl * p))
         }
     }
 
-    /// [`BoState::select_with`] with a fresh number per tree level from `next` (uniform in
-    /// [0, 1)), any source of random numbers: `(light, selection probability)`, the
+    /// [`BoState::select_with`] with 64 fresh uniform bits per tree level from `next`, any
+    /// source of random numbers: `(light, selection probability)`, the
     /// probability [`BoState::selection_pmf`] gives for that light.
     pub fn select_from(
         &self,
         tree: &LightTree,
         u_cluster: f32,
-        next: impl FnMut() -> f32,
+        next: impl FnMut() -> u64,
     ) -> Option<(usize, f32)> {
         let cut = self.cut();
         let (k, p_cl, _) = cut.pick(u_cluster)?;

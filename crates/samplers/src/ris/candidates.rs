@@ -88,7 +88,7 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
     /// nothing (a dead end, or a point that emits nothing towards x): a candidate of weight 0.
     pub fn sample(&self, j: u32, rng: &mut SampleStream) -> Option<Drawn> {
         if j < self.n_ls {
-            let u = rng.next_f32();
+            let u = rng.next_u64();
             let (light, _) = self.tree.sample_subtree(
                 self.tree.root(),
                 |c| self.tree_importance(c),
