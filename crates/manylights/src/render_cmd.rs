@@ -14,17 +14,13 @@ pub struct RenderArgs {
     /// A glTF file (.gltf/.glb), a pbrt scene (.pbrt), a composition (.toml) or
     /// `builtin:NAME?key=value&...`.
     pub scene: String,
-    #[arg(long, default_value = "power+bsdf")]
-    pub strategy: String,
+    #[command(flatten)]
+    pub strategy: StrategyArgs,
     /// Samples per pixel (default 16; with --time-budget, the most to take, unlimited if not given).
     #[arg(long)]
     pub spp: Option<u32>,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Where the samples' numbers come from: `independent` numbers per dimension, or `sobol`,
-    /// shuffled Owen-scrambled (0,2)-sequences in consecutive dimension pairs.
-    #[arg(long, default_value_t = Sampler::Independent, value_parser = sampler_parser())]
-    pub sampler: Sampler,
     #[arg(long)]
     pub width: Option<u32>,
     #[arg(long)]
@@ -53,6 +49,23 @@ pub struct RenderArgs {
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
     #[arg(long)]
     pub aux: bool,
+    /// Print ray throughput.
+    #[arg(long)]
+    pub stats: bool,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// What determines the strategy a render uses: its name, its knobs and the sampler
+/// (`manylights strategy` takes the same flags and prints them resolved).
+#[derive(Args, Debug, Clone)]
+pub struct StrategyArgs {
+    #[arg(long, default_value = "power+bsdf")]
+    pub strategy: String,
+    /// Where the samples' numbers come from: `independent` numbers per dimension, or `sobol`,
+    /// shuffled Owen-scrambled (0,2)-sequences in consecutive dimension pairs.
+    #[arg(long, default_value_t = Sampler::Independent, value_parser = sampler_parser())]
+    pub sampler: Sampler,
     /// Adaptive tree splitting threshold τ (tree-split and mis3 strategies) [default: 0.35, the
     /// authors' 0.85 with --reproduce].
     #[arg(long)]
@@ -60,13 +73,25 @@ pub struct RenderArgs {
     /// Most clusters in an adaptive light cut (tree-split strategies; mis3: both cuts).
     #[arg(long, default_value_t = StrategyOptions::default().max_cut)]
     pub max_cut: usize,
-    /// Print ray throughput.
-    #[arg(long)]
-    pub stats: bool,
     #[command(flatten)]
     pub method: MethodArgs,
-    #[arg(long)]
-    pub quiet: bool,
+}
+
+impl StrategyArgs {
+    pub fn options(&self) -> StrategyOptions {
+        self.method.options(self.tau, self.max_cut)
+    }
+
+    /// The strategy's name, every parameter it renders with (defaults filled in) and the
+    /// sampler: what the render's JSON records as `resolved_strategy`.
+    pub fn resolved(&self) -> anyhow::Result<serde_json::Value> {
+        let parameters = samplers::resolve::resolved_parameters(&self.strategy, &self.options())?;
+        Ok(serde_json::json!({
+            "strategy": self.strategy,
+            "parameters": parameters,
+            "sampler": self.sampler.name(),
+        }))
+    }
 }
 
 /// Knobs of the light-tree and Liu et al. 2019 strategies; their defaults are
@@ -229,8 +254,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("warning: {w}");
         }
     }
-    let opts = args.method.options(args.tau, args.max_cut);
-    let strategy = samplers::create(&args.strategy, &scene, &opts)?;
+    let opts = args.strategy.options();
+    let resolved = args.strategy.resolved()?;
+    let strategy = samplers::create(&args.strategy.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
     }
@@ -263,7 +289,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         }),
         threads: args.threads,
         camera: camera.clone(),
-        sampler: args.sampler,
+        sampler: args.strategy.sampler,
     };
     let bar = if args.quiet {
         ProgressBar::hidden()
@@ -326,8 +352,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let meta = serde_json::json!({
         "scene": args.scene,
         "scene_stats": scene.stats,
+        "scene_hash": scene.content_hash(),
         "strategy": strategy.name(),
         "strategy_parameters": strategy.parameters(),
+        "resolved_strategy": resolved,
         "spp": result.spp,
         "partial_pass_pixels": result.partial_pixels,
         "unsampled_pixels": result.unsampled_pixels(),
@@ -337,7 +365,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "time_budget_s": args.time_budget,
         "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
         "seed": args.seed,
-        "sampler": args.sampler.name(),
+        "sampler": args.strategy.sampler.name(),
         "width": width,
         "height": height,
         "camera": camera,
