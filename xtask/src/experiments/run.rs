@@ -51,6 +51,12 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         &options,
         start,
     )?;
+    if !done.references_rendered.is_empty() {
+        eprintln!(
+            "references rendered: {}",
+            done.references_rendered.join(", ")
+        );
+    }
     finish(&exp, &out, done.notices, start, done.failed, &perm)
 }
 

@@ -220,7 +220,7 @@ fn code_words(p: &Provenance) -> String {
     let mut s = format!("**{}**", main.describe());
     if p.dirty {
         s.push_str(
-            " — **cells of a dirty build, written with --allow-dirty: not a committed state**",
+            " — **it includes cells of a dirty build (written with --allow-dirty): not a committed state**",
         );
     }
     let others: Vec<String> = p
