@@ -208,14 +208,15 @@ pub fn say(multi: &MultiProgress, msg: String) -> std::io::Result<()> {
     }
 }
 
-/// Merges the notices with those of earlier runs, writes the report.
+/// Merges the notices with those of earlier runs, writes the report (unless `perm` is `None`:
+/// a `--references-only` run has no new cells to report).
 fn finish(
     exp: &Experiment,
     out: &Path,
     mut notices: Vec<Notice>,
     start: Instant,
     failed: bool,
-    perm: &provenance::Permissions,
+    perm: Option<&provenance::Permissions>,
 ) -> Result<ExitCode, String> {
     std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
     notices.sort();
@@ -224,7 +225,9 @@ fn finish(
         &out.join("notices.json"),
         &serde_json::to_value(&notices).unwrap(),
     )?;
-    summary::generate(exp, out, &references_dir(), &notices, perm)?;
+    if let Some(perm) = perm {
+        summary::generate(exp, out, &references_dir(), &notices, perm)?;
+    }
     eprintln!(
         "results in {} ({:.1} s in all)",
         out.display(),
@@ -251,7 +254,7 @@ fn merge(args: MergeArgs) -> Result<ExitCode, String> {
     };
     let copied = merge_into(&args.sources, &out, &mut notices, &perm)?;
     eprintln!("merged {copied} cell files into {}", out.display());
-    finish(&exp, &out, notices, Instant::now(), false, &perm)
+    finish(&exp, &out, notices, Instant::now(), false, Some(&perm))
 }
 
 /// Copies cells (and their renders, when present) from `sources` into `out`. The cells of

@@ -57,7 +57,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
             done.references_rendered.join(", ")
         );
     }
-    finish(&exp, &out, done.notices, start, done.failed, &perm)
+    let report = (!options.references_only).then_some(&perm);
+    finish(&exp, &out, done.notices, start, done.failed, report)
 }
 
 /// What a run was asked to do beyond the cells.
