@@ -277,7 +277,7 @@ pub fn format_time_table(
     s
 }
 
-pub const CSV_HEADER: [&str; 26] = [
+pub const CSV_HEADER: [&str; 29] = [
     "id",
     "scene",
     "strategy",
@@ -304,6 +304,9 @@ pub const CSV_HEADER: [&str; 26] = [
     "technique_samples",
     "strategy_parameters",
     "git_commit",
+    "code_state",
+    "code_commit",
+    "code_dirty",
 ];
 
 pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), String> {
@@ -311,6 +314,7 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
         let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
         w.write_record(CSV_HEADER).map_err(|e| e.to_string())?;
         for c in cells {
+            let code = super::provenance::code_of(c);
             let (kind, value) = match c.budget {
                 Budget::Spp(n) => ("spp", n.to_string()),
                 Budget::Time(t) => ("time", t.to_string()),
@@ -342,6 +346,9 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
                 c.render["technique_samples"].to_string(),
                 c.render["strategy_parameters"].to_string(),
                 c.render["git_commit"].as_str().unwrap_or("").to_string(),
+                code.id.clone(),
+                code.commit.clone().unwrap_or_default(),
+                code.dirty.to_string(),
             ])
             .map_err(|e| e.to_string())?;
         }

@@ -704,6 +704,21 @@ mod tests {
         assert!(out.join("plots/s.png").is_file());
         let csv = std::fs::read_to_string(out.join("cells.csv")).unwrap();
         assert_eq!(csv.lines().count(), cells.len());
+        // cells from before code states were recorded: their render's commit stands in
+        assert!(
+            csv.lines()
+                .next()
+                .unwrap()
+                .ends_with("code_state,code_commit,code_dirty")
+        );
+        assert!(
+            csv.lines()
+                .nth(1)
+                .unwrap()
+                .ends_with("legacy:abc,abc,false"),
+            "{csv}"
+        );
+        assert!(md.contains("rendered by **commit abc**"), "{md}");
         let _ = std::fs::remove_dir_all(&out);
     }
 }
