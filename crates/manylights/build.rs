@@ -1,4 +1,8 @@
-//! Records the git commit the binary was built from, when there is one.
+//! Records the git commit the binary was built from, when there is one, with `-dirty` when a
+//! file that builds it (crates/, Cargo.toml, Cargo.lock, .cargo/) differs from the commit;
+//! results and documentation do not count. Cargo reruns this only when HEAD or the index
+//! change, so the mark can lag an edit: the experiment harness decides dirtiness itself
+//! (xtask/src/experiments/provenance.rs).
 fn main() {
     let commit = std::process::Command::new("git")
         .args(["rev-parse", "--short=12", "HEAD"])
@@ -8,7 +12,16 @@ fn main() {
         .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
         .unwrap_or_default();
     let dirty = std::process::Command::new("git")
-        .args(["status", "--porcelain", "--untracked-files=no"])
+        .args([
+            "status",
+            "--porcelain",
+            "--untracked-files=no",
+            "--",
+            ":/crates",
+            ":/Cargo.toml",
+            ":/Cargo.lock",
+            ":/.cargo",
+        ])
         .output()
         .ok()
         .is_some_and(|o| o.status.success() && !o.stdout.is_empty());

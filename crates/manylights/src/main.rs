@@ -39,6 +39,15 @@ enum Command {
     Scenes,
     /// List the strategies.
     Strategies,
+    /// Print a strategy's resolved parameters (every default filled in) and sampler as JSON:
+    /// what `render` with the same flags records as `resolved_strategy`.
+    Strategy {
+        #[command(flatten)]
+        args: render_cmd::StrategyArgs,
+        /// Print JSON (the only format; accepted for symmetry with `info --json`).
+        #[arg(long)]
+        json: bool,
+    },
     /// ∫ over a spherical cap of the un-Fresnelled GGX lobe times cos θ (height-correlated
     /// Smith), zero below the horizon. Reads CSV rows `alpha,theta_o,cap_x,cap_y,cap_z,cap_cos`
     /// on stdin (θo in radians, ωo = (sin θo, 0, cos θo), cap axis in the local frame with z the
@@ -87,6 +96,10 @@ fn main() -> ExitCode {
             worst,
         } => compare(&image, &reference, &mask, json, worst),
         Command::CapIntegral { method } => cap_integral(&method),
+        Command::Strategy { args, json: _ } => args.resolved().and_then(|v| {
+            println!("{}", serde_json::to_string_pretty(&v)?);
+            Ok(())
+        }),
         Command::Strategies => {
             for s in samplers::strategies() {
                 println!("{:<18} {}", s.name, s.description);
@@ -133,11 +146,12 @@ fn info(spec: &str, json: bool) -> anyhow::Result<()> {
     let scene = scene_formats::load_scene(spec, None)?;
     let s = &scene.stats;
     if json {
-        let v = serde_json::json!({ "scene": spec, "stats": s, "bounds": [scene.bounds.0.to_array(), scene.bounds.1.to_array()], "cameras": scene.cameras.iter().map(|c| &c.name).collect::<Vec<_>>() });
+        let v = serde_json::json!({ "scene": spec, "scene_hash": scene.content_hash(), "stats": s, "bounds": [scene.bounds.0.to_array(), scene.bounds.1.to_array()], "cameras": scene.cameras.iter().map(|c| &c.name).collect::<Vec<_>>() });
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
     println!("scene          {spec}");
+    println!("content hash   {}", scene.content_hash());
     println!(
         "triangles      {} ({} degenerate skipped)",
         s.triangles, s.degenerate_triangles_skipped

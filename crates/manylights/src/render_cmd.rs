@@ -15,19 +15,13 @@ pub struct RenderArgs {
     /// A glTF file (.gltf/.glb), a pbrt scene (.pbrt), a composition (.toml) or
     /// `builtin:NAME?key=value&...`.
     pub scene: String,
-    #[arg(long, default_value = "power+bsdf")]
-    pub strategy: String,
+    #[command(flatten)]
+    pub strategy: StrategyArgs,
     /// Samples per pixel (default 16; with --time-budget, the most to take, unlimited if not given).
     #[arg(long)]
     pub spp: Option<u32>,
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
-    /// Where the samples' numbers come from: `independent` numbers per dimension (the default),
-    /// `stratified` (jittered, needs --spp), `sobol` (Owen-scrambled (0,2)-sequences per
-    /// dimension pair), `lowdiscrepancy` (pbrt-v3's, the default under --reproduce) or
-    /// `zsobol` (pbrt-v4's: one sequence over the image in Morton order, needs --spp).
-    #[arg(long, value_parser = sampler_parser())]
-    pub sampler: Option<Sampler>,
     /// The pixel filter, `NAME[:RADIUS]`: box (radius 0.5 by default), triangle (2), gaussian
     /// (1.5, sigma 0.5) or mitchell (2, B = C = 1/3), sampled by filter importance sampling.
     /// The scene file's own `PixelFilter` is used when this is not given.
@@ -63,6 +57,26 @@ pub struct RenderArgs {
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
     #[arg(long)]
     pub aux: bool,
+    /// Print ray throughput.
+    #[arg(long)]
+    pub stats: bool,
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+/// What determines the strategy a render uses: its name, its knobs and the sampler
+/// (`manylights strategy` takes the same flags and prints them resolved).
+#[derive(Args, Debug, Clone)]
+pub struct StrategyArgs {
+    #[arg(long, default_value = "power+bsdf")]
+    pub strategy: String,
+    /// Where the samples' numbers come from: `independent` numbers per dimension (the default),
+    /// `stratified` (jittered, needs --spp), `sobol` (Owen-scrambled (0,2)-sequences per
+    /// dimension pair), `lowdiscrepancy` (pbrt-v3's, the default under --reproduce) or
+    /// `zsobol` (pbrt-v4's: one sequence over the image in Morton order, needs --spp). A
+    /// scene file's own `Sampler` is used when this is not given.
+    #[arg(long, value_parser = sampler_parser())]
+    pub sampler: Option<Sampler>,
     /// Adaptive tree splitting threshold τ (tree-split and mis3 strategies) [default: 0.35, the
     /// authors' 0.85 with --reproduce].
     #[arg(long)]
@@ -70,13 +84,27 @@ pub struct RenderArgs {
     /// Most clusters in an adaptive light cut (tree-split strategies; mis3: both cuts).
     #[arg(long, default_value_t = StrategyOptions::default().max_cut)]
     pub max_cut: usize,
-    /// Print ray throughput.
-    #[arg(long)]
-    pub stats: bool,
     #[command(flatten)]
     pub method: MethodArgs,
-    #[arg(long)]
-    pub quiet: bool,
+}
+
+impl StrategyArgs {
+    pub fn options(&self) -> StrategyOptions {
+        self.method.options(self.tau, self.max_cut)
+    }
+
+    /// The strategy's name, every parameter it renders with (defaults filled in) and the
+    /// sampler flag (none: the scene file's, or `lowdiscrepancy` under `--reproduce`, or
+    /// `independent`; the scene's choice is covered by its `scene_hash`): what the render's
+    /// JSON records as `resolved_strategy`.
+    pub fn resolved(&self) -> anyhow::Result<serde_json::Value> {
+        let parameters = samplers::resolve::resolved_parameters(&self.strategy, &self.options())?;
+        Ok(serde_json::json!({
+            "strategy": self.strategy,
+            "parameters": parameters,
+            "sampler": self.sampler.map(Sampler::name),
+        }))
+    }
 }
 
 /// Knobs of the light-tree and Liu et al. 2019 strategies; their defaults are
@@ -257,14 +285,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("warning: {w}");
         }
     }
-    let opts = args.method.options(args.tau, args.max_cut);
-    let (sampler, sampler_from) = choose_sampler(args.sampler, &scene, opts.reproduce);
+    let opts = args.strategy.options();
+    let resolved = args.strategy.resolved()?;
+    let (sampler, sampler_from) = choose_sampler(args.strategy.sampler, &scene, opts.reproduce);
     let (filter, filter_from) = match (&args.filter, &scene.render_hints.filter) {
         (Some(f), _) => (f.clone(), "--filter"),
         (None, Some(f)) => (f.clone(), "scene file"),
         (None, None) => (PixelFilter::default(), "default"),
     };
-    let strategy = samplers::create(&args.strategy, &scene, &opts)?;
+    let strategy = samplers::create(&args.strategy.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
     }
@@ -364,8 +393,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let meta = serde_json::json!({
         "scene": args.scene,
         "scene_stats": scene.stats,
+        "scene_hash": scene.content_hash(),
         "strategy": strategy.name(),
         "strategy_parameters": strategy.parameters(),
+        "resolved_strategy": resolved,
         "spp": result.spp,
         "partial_pass_pixels": result.partial_pixels,
         "unsampled_pixels": result.unsampled_pixels(),

@@ -683,3 +683,68 @@ fn preview_exposure_negative_and_auto() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--exposure must be a finite"));
 }
+
+fn json_of(o: &Output) -> serde_json::Value {
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+#[test]
+fn scene_hash_covers_included_files_and_render_records_what_strategy_resolves() {
+    let dir = temp_dir("hash");
+    let scene = dir.join("s.pbrt");
+    std::fs::write(
+        &scene,
+        "LookAt 0 1 4  0 0.5 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\nWorldBegin\nInclude \"geom.pbrt\"\n",
+    )
+    .unwrap();
+    let geom = |radius: &str| {
+        std::fs::write(
+            dir.join("geom.pbrt"),
+            format!(
+                "Shape \"bilinearmesh\" \"point3 P\" [ -2 0 -2  2 0 -2  -2 0 2  2 0 2 ]\n\
+                 AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [ 50 50 50 ]\n\
+                 Translate 0 1.5 0\nShape \"sphere\" \"float radius\" {radius}\nAttributeEnd\n"
+            ),
+        )
+        .unwrap()
+    };
+    let s = scene.to_str().unwrap();
+    let hash = || json_of(&manylights(&["info", s, "--json"]))["scene_hash"].clone();
+    geom("0.05");
+    let a = hash();
+    assert_eq!(a.as_str().map(str::len), Some(32), "{a}");
+    assert_eq!(a, hash(), "the same files, the same hash");
+    geom("0.06");
+    let b = hash();
+    assert_ne!(a, b, "a change in the included file changes the hash");
+    // a change that loads to the same scene (a comment) does not
+    std::fs::write(dir.join("geom.pbrt"), {
+        let mut t = std::fs::read_to_string(dir.join("geom.pbrt")).unwrap();
+        t.push_str("# a comment\n");
+        t
+    })
+    .unwrap();
+    assert_eq!(b, hash());
+
+    // `strategy --json` gives what the render records, defaults included
+    let flags = ["--strategy", "mis3-adaptive", "--lambda", "3"];
+    let mut args = vec!["strategy", "--json"];
+    args.extend(flags);
+    let resolved = json_of(&manylights(&args));
+    assert_eq!(resolved["parameters"]["method"]["lambda"], 3.0);
+    assert_eq!(resolved["parameters"]["method"]["n_max"], 50, "a default");
+    let out = dir.join("r.exr");
+    let mut args = vec!["render", s, "--spp", "1", "--width", "8", "--height", "6"];
+    args.extend(flags);
+    args.extend(["--quiet", "--out", out.to_str().unwrap()]);
+    let o = manylights(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
+    assert_eq!(meta["resolved_strategy"], resolved);
+    assert_eq!(meta["scene_hash"], b);
+    let o = manylights(&["strategy", "--strategy", "no-such"]);
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("unknown strategy `no-such`"));
+}

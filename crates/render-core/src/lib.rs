@@ -27,6 +27,7 @@ pub mod rng;
 pub mod sampler;
 pub mod sampling;
 pub mod scene;
+pub mod scene_hash;
 pub mod scene_hints;
 pub mod stats;
 pub mod texture;

@@ -29,6 +29,7 @@ mod memo;
 pub mod mis;
 pub mod oracle;
 pub mod point_sets;
+pub mod resolve;
 pub mod ris;
 mod scratch;
 pub mod selection;
@@ -234,12 +235,8 @@ pub fn strategies() -> Vec<StrategyInfo> {
     ]
 }
 
-/// Builds the strategy called `name` for `scene`.
-pub fn create(
-    name: &str,
-    scene: &Scene,
-    opts: &StrategyOptions,
-) -> Result<Box<dyn DirectLighting>, StrategyError> {
+/// The options every strategy refuses: negative δ or λ, an empty cut, τ outside [0, 1].
+pub(crate) fn check_options(opts: &StrategyOptions) -> Result<(), StrategyError> {
     if !(opts.delta >= 0.0) || !(opts.lambda >= 0.0) {
         return Err(StrategyError::BadOption(format!(
             "need δ ≥ 0 and λ ≥ 0, got δ = {}, λ = {}",
@@ -253,6 +250,16 @@ pub fn create(
             opts.tau()
         )));
     }
+    Ok(())
+}
+
+/// Builds the strategy called `name` for `scene` (its parameters: [`resolve::resolved_parameters`]).
+pub fn create(
+    name: &str,
+    scene: &Scene,
+    opts: &StrategyOptions,
+) -> Result<Box<dyn DirectLighting>, StrategyError> {
+    check_options(opts)?;
     let units = opts.power_units();
     let tree = |mode: TreeMode,
                 with_bsdf: bool|
@@ -329,9 +336,8 @@ fn mis3(
     scene: &Scene,
     opts: &StrategyOptions,
 ) -> Result<Box<dyn DirectLighting>, StrategyError> {
-    use brdf_integrals::{Intersection, Lookup, Normalization, Sptd};
+    use brdf_oriented::BrdfIntegral;
     use brdf_oriented::mis3::{Mis3, Mis3Mode};
-    use brdf_oriented::{BoConfig, BrdfIntegral};
     let mode = match name {
         "brdf-oriented" => Mis3Mode::BoOnly,
         "mis3-equal" => Mis3Mode::Equal,
@@ -343,41 +349,18 @@ fn mis3(
         opts.power_units(),
     )
     .map_err(StrategyError::BadOption)?;
-    let config = BoConfig {
-        delta: opts.delta,
-        n_max: opts.n_max,
-        lambda: opts.lambda,
-        tau: opts.tau(),
-        max_cut: opts.split_params().max_size,
-        max_cut_bo: opts.split_params().max_size,
-        brdf_integral: opts.brdf_integral,
-        reproduce: opts.reproduce,
-        pivot_sphere: opts.pivot_sphere,
-        adaptive_total: opts.adaptive_total,
-        weighted_ub: opts.weighted_ub,
-        efficient_total: opts.efficient_total && !opts.reproduce,
-        stratified: opts.stratified && !opts.reproduce,
-        single_ls_at_glossy: !opts.split_ls_at_glossy && !opts.reproduce,
-        adaptive_split: opts.adaptive_split,
-    };
+    let config = resolve::bo_config(opts);
     Ok(match opts.brdf_integral {
-        BrdfIntegral::Sptd => {
-            let integral = if opts.reproduce {
-                Sptd::default()
-                    .lookup(Lookup::Nearest)
-                    .intersection(Intersection::OatSander)
-                    .normalization(Normalization::FullSphere)
-            } else {
-                Sptd::default()
-            };
-            Box::new(Mis3::new(name.into(), mode, ls, integral, config))
-        }
+        BrdfIntegral::Sptd => Box::new(Mis3::new(
+            name.into(),
+            mode,
+            ls,
+            resolve::sptd(opts),
+            config,
+        )),
         BrdfIntegral::Ltc => {
             use brdf_integrals::CapIntegral;
-            let mut integral = brdf_integrals::Ltc::default();
-            if opts.reproduce {
-                integral.lookup = Lookup::Nearest;
-            }
+            let integral = resolve::ltc(opts);
             // Sanity check of the table (a placeholder build would integrate to 0).
             let probe = integral.hemisphere(render_core::Vec3::new(0.6, 0.0, 0.8), 0.1);
             if !(probe > 0.0) {
@@ -391,7 +374,7 @@ fn mis3(
 }
 
 /// Candidate count of a `ris` strategy name: `ris` (8), `ris-N` (1 ≤ N ≤ 1024), `ris-adaptive`.
-fn ris_count(name: &str) -> Option<ris::CandidateCount> {
+pub(crate) fn ris_count(name: &str) -> Option<ris::CandidateCount> {
     use ris::CandidateCount;
     match name {
         "ris" => Some(CandidateCount::Fixed(8)),

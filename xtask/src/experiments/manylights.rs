@@ -96,6 +96,28 @@ impl Manylights {
         Ok(Manylights { exe, root })
     }
 
+    /// The debug `manylights` beside a test binary (target/debug/deps/…), built first: the
+    /// harness's tests render tiny scenes with it.
+    #[cfg(test)]
+    pub fn for_tests() -> Self {
+        use std::sync::OnceLock;
+        static BUILT: OnceLock<bool> = OnceLock::new();
+        let root = repo_root();
+        let ok = *BUILT.get_or_init(|| {
+            Command::new(env!("CARGO"))
+                .args(["build", "--quiet", "-p", "manylights"])
+                .current_dir(&root)
+                .status()
+                .is_ok_and(|s| s.success())
+        });
+        assert!(ok, "`cargo build -p manylights` failed");
+        let me = std::env::current_exe().unwrap();
+        let dir = me.parent().unwrap().parent().unwrap();
+        let exe = dir.join(format!("manylights{}", std::env::consts::EXE_SUFFIX));
+        assert!(exe.exists(), "no {}", exe.display());
+        Manylights { exe, root }
+    }
+
     fn command(&self) -> Command {
         let mut c = Command::new(&self.exe);
         c.current_dir(&self.root);
@@ -126,10 +148,18 @@ impl Manylights {
         self.output(&["render", "--help"]).unwrap_or_default()
     }
 
-    pub fn version(&self) -> String {
-        self.output(&["--version"])
-            .map(|s| s.trim().to_string())
-            .unwrap_or_default()
+    /// `manylights strategy --strategy NAME ARGS… --json`: the strategy's resolved parameters
+    /// and sampler.
+    pub fn resolved_strategy(
+        &self,
+        name: &str,
+        args: &[String],
+    ) -> Result<serde_json::Value, Failure> {
+        let mut all: Vec<&str> = vec!["strategy", "--json", "--strategy", name];
+        all.extend(args.iter().map(String::as_str));
+        let text = self.output(&all)?;
+        serde_json::from_str(&text)
+            .map_err(|e| Failure::Error(format!("bad `manylights strategy` JSON: {e}")))
     }
 
     /// `manylights info SPEC --json`.

@@ -4,8 +4,11 @@
 pub mod charts;
 pub mod compositing;
 pub mod config;
+#[cfg(test)]
+mod keys_tests;
 pub mod manylights;
 pub mod plan;
+pub mod provenance;
 pub mod reference;
 pub mod report;
 pub mod run;
@@ -50,6 +53,16 @@ pub struct RunArgs {
     /// Render finished cells again.
     #[arg(long)]
     pub rerender: bool,
+    /// Keep finished cells rendered by other code when nothing else that keys them changed
+    /// (scene, strategy parameters, threads, reference); the table marks their rows.
+    #[arg(long)]
+    pub reuse_stale: bool,
+    /// Write the table even from cells rendered by a dirty build (its header says so).
+    #[arg(long)]
+    pub allow_dirty: bool,
+    /// Write the table even from cells of several code states or references (rows marked).
+    #[arg(long)]
+    pub allow_mixed: bool,
     /// Render (or check) the references and stop.
     #[arg(long)]
     pub references_only: bool,
@@ -73,6 +86,13 @@ pub struct MergeArgs {
     pub sources: Vec<PathBuf>,
     #[arg(long)]
     pub results: Option<PathBuf>,
+    /// Write the table even from cells rendered by a dirty build (its header says so).
+    #[arg(long)]
+    pub allow_dirty: bool,
+    /// Merge cells of several code states or references (rows marked) and, where two sources
+    /// hold different results for one cell, take the one named last.
+    #[arg(long)]
+    pub allow_mixed: bool,
 }
 
 pub fn experiments_dir() -> PathBuf {
@@ -179,11 +199,6 @@ fn read_cell(path: &Path) -> Option<CellResult> {
     serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
 }
 
-/// Whether the finished cell at `path` can be kept: same plan key and same reference.
-pub fn is_done(path: &Path, key: &str, reference_id: &str) -> bool {
-    read_cell(path).is_some_and(|c| c.key == key && c.reference == reference_id)
-}
-
 /// A line above the progress bars, or on stderr when they are hidden (no terminal).
 pub fn say(multi: &MultiProgress, msg: String) -> std::io::Result<()> {
     if multi.is_hidden() {
@@ -194,13 +209,15 @@ pub fn say(multi: &MultiProgress, msg: String) -> std::io::Result<()> {
     }
 }
 
-/// Merges the notices with those of earlier runs, writes the report.
+/// Merges the notices with those of earlier runs, writes the report (unless `perm` is `None`:
+/// a `--references-only` run has no new cells to report).
 fn finish(
     exp: &Experiment,
     out: &Path,
     mut notices: Vec<Notice>,
     start: Instant,
     failed: bool,
+    perm: Option<&provenance::Permissions>,
 ) -> Result<ExitCode, String> {
     std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
     notices.sort();
@@ -209,7 +226,9 @@ fn finish(
         &out.join("notices.json"),
         &serde_json::to_value(&notices).unwrap(),
     )?;
-    summary::generate(exp, out, &references_dir(), &notices)?;
+    if let Some(perm) = perm {
+        summary::generate(exp, out, &references_dir(), &notices, perm)?;
+    }
     eprintln!(
         "results in {} ({:.1} s in all)",
         out.display(),
@@ -229,50 +248,94 @@ fn merge(args: MergeArgs) -> Result<ExitCode, String> {
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
         .unwrap_or_default();
-    let copied = merge_into(&args.sources, &out, &mut notices)?;
+    let perm = provenance::Permissions {
+        allow_dirty: args.allow_dirty,
+        allow_mixed: args.allow_mixed,
+        current: None,
+    };
+    let copied = merge_into(&args.sources, &out, &mut notices, &perm)?;
     eprintln!("merged {copied} cell files into {}", out.display());
-    finish(&exp, &out, notices, Instant::now(), false)
+    finish(&exp, &out, notices, Instant::now(), false, Some(&perm))
 }
 
-/// Copies cells (and renders, when present) from `sources` into `out`; a cell present in
-/// several is taken from the newest file. Returns how many cell files were copied.
+/// Copies cells (and their renders, when present) from `sources` into `out`. The cells of
+/// `out` and of every source together must be one code state with one reference per scene
+/// (unless `perm.allow_mixed`), and a cell held by two of them with different results is a
+/// conflict (unless `perm.allow_mixed`: then the source named last wins). File times play no
+/// part. Returns how many cell files were copied.
 pub fn merge_into(
     sources: &[PathBuf],
     out: &Path,
     notices: &mut Vec<Notice>,
+    perm: &provenance::Permissions,
 ) -> Result<usize, String> {
-    let mut copied = 0;
-    for sub in ["cells", "renders"] {
-        std::fs::create_dir_all(out.join(sub)).map_err(|e| e.to_string())?;
-    }
     for src in sources {
         if !src.is_dir() {
             return Err(format!("{} is not a directory", src.display()));
         }
-        for sub in ["cells", "renders"] {
-            let Ok(entries) = std::fs::read_dir(src.join(sub)) else {
-                continue;
-            };
-            for e in entries.flatten() {
-                let from = e.path();
-                let to = out.join(sub).join(e.file_name());
-                let newer = match (from.metadata(), to.metadata()) {
-                    (Ok(a), Ok(b)) => a.modified().ok() > b.modified().ok(),
-                    (Ok(_), Err(_)) => true,
-                    _ => false,
-                };
-                if newer && from.canonicalize().ok() != to.canonicalize().ok() {
-                    render_core::output::write_atomically(&to, |tmp| {
-                        std::fs::copy(&from, tmp)
-                            .map(|_| ())
-                            .map_err(|e| e.to_string())
-                    })?;
-                    if sub == "cells" {
-                        copied += 1;
-                    }
-                }
+    }
+    // Every cell id → (the directory its chosen result is in, the result); `out` first.
+    let mut chosen: std::collections::BTreeMap<String, (PathBuf, CellResult)> = Default::default();
+    let mut conflicts = Vec::new();
+    for dir in std::iter::once(&out.to_path_buf()).chain(sources) {
+        let Ok(entries) = std::fs::read_dir(dir.join("cells")) else {
+            continue;
+        };
+        let mut files: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
+        files.sort();
+        for f in files
+            .iter()
+            .filter(|f| f.extension().is_some_and(|x| x == "json"))
+        {
+            let c = read_cell(f).ok_or_else(|| format!("{} is not a cell file", f.display()))?;
+            if let Some((d, old)) = chosen.get(&c.id)
+                && old != &c
+                && d != out
+            {
+                conflicts.push(format!(
+                    "{} differs between {} and {}",
+                    c.id,
+                    d.display(),
+                    dir.display()
+                ));
+            }
+            chosen.insert(c.id.clone(), (dir.clone(), c));
+        }
+    }
+    if !conflicts.is_empty() && !perm.allow_mixed {
+        return Err(format!(
+            "refusing to merge: {} (pass --allow-mixed to take the source named last)",
+            conflicts.join("; ")
+        ));
+    }
+    let cells: Vec<CellResult> = chosen.values().map(|(_, c)| c.clone()).collect();
+    provenance::Provenance::check(&cells, perm)?;
+    for sub in ["cells", "renders"] {
+        std::fs::create_dir_all(out.join(sub)).map_err(|e| e.to_string())?;
+    }
+    let mut copied = 0;
+    for (id, (dir, _)) in &chosen {
+        if dir.canonicalize().ok() == out.canonicalize().ok() {
+            continue;
+        }
+        let file = format!("{id}.json");
+        copy_atomically(
+            &dir.join("cells").join(&file),
+            &out.join("cells").join(&file),
+        )?;
+        copied += 1;
+        // The render and its siblings (<id>.exr, <id>.json, <id>.mask.png, …).
+        let Ok(entries) = std::fs::read_dir(dir.join("renders")) else {
+            continue;
+        };
+        let prefix = format!("{id}.");
+        for e in entries.flatten() {
+            if e.file_name().to_string_lossy().starts_with(&prefix) {
+                copy_atomically(&e.path(), &out.join("renders").join(e.file_name()))?;
             }
         }
+    }
+    for src in sources {
         if let Some(n) = std::fs::read_to_string(src.join("notices.json"))
             .ok()
             .and_then(|t| serde_json::from_str::<Vec<Notice>>(&t).ok())
@@ -283,15 +346,32 @@ pub fn merge_into(
     Ok(copied)
 }
 
+fn copy_atomically(from: &Path, to: &Path) -> Result<(), String> {
+    render_core::output::write_atomically(to, |tmp| {
+        std::fs::copy(from, tmp)
+            .map(|_| ())
+            .map_err(|e| format!("cannot copy {}: {e}", from.display()))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use plan::Budget;
+    use provenance::{CodeState, Permissions};
 
-    fn cell_file(dir: &Path, id: &str, key: &str, reference: &str) -> PathBuf {
-        let c = CellResult {
+    pub fn code(id: &str, dirty: bool) -> CodeState {
+        CodeState {
             id: id.into(),
-            key: key.into(),
+            commit: Some("0123456789ab".into()),
+            dirty,
+        }
+    }
+
+    pub fn cell_result(id: &str, reference: &str, code_id: &str) -> CellResult {
+        CellResult {
+            id: id.into(),
+            key: "k".into(),
             experiment: "t".into(),
             scene: "s".into(),
             scene_spec: "builtin:s".into(),
@@ -311,45 +391,85 @@ mod tests {
             wall_seconds: 1.0,
             cpu_seconds: 2.0,
             render: serde_json::json!({}),
-        };
+            code: Some(code(code_id, false)),
+            inputs: None,
+        }
+    }
+
+    fn cell_file(dir: &Path, c: &CellResult) -> PathBuf {
         std::fs::create_dir_all(dir).unwrap();
-        let p = dir.join(format!("{id}.json"));
-        render_core::output::write_json(&p, &serde_json::to_value(&c).unwrap()).unwrap();
+        let p = dir.join(format!("{}.json", c.id));
+        render_core::output::write_json(&p, &serde_json::to_value(c).unwrap()).unwrap();
         p
     }
 
     #[test]
-    fn a_finished_cell_is_skipped_unless_stale() {
-        let dir = std::env::temp_dir().join(format!("xtask-resume-{}", std::process::id()));
-        let p = cell_file(&dir, "c1", "k1", "r1");
-        assert!(is_done(&p, "k1", "r1"));
-        assert!(!is_done(&p, "k2", "r1"), "another plan key: stale");
-        assert!(!is_done(&p, "k1", "r2"), "another reference: stale");
-        assert!(!is_done(&dir.join("absent.json"), "k1", "r1"));
-        std::fs::write(dir.join("broken.json"), "{\"id\":").unwrap();
-        assert!(
-            !is_done(&dir.join("broken.json"), "k1", "r1"),
-            "a partial file is not done"
+    fn merge_copies_cells_and_renders_from_shards() {
+        let base = std::env::temp_dir().join(format!("xtask-merge-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&base);
+        cell_file(&base.join("s1/cells"), &cell_result("c1", "r", "tree:a"));
+        cell_file(&base.join("s2/cells"), &cell_result("c2", "r", "tree:a"));
+        std::fs::create_dir_all(base.join("s2/renders")).unwrap();
+        std::fs::write(base.join("s2/renders/c2.exr"), "x").unwrap();
+        std::fs::write(base.join("s2/renders/c22.exr"), "not c2's").unwrap();
+        let mut notices = vec![];
+        let out = base.join("out");
+        let perm = Permissions::default();
+        let n = merge_into(
+            &[base.join("s1"), base.join("s2")],
+            &out,
+            &mut notices,
+            &perm,
         );
-        let _ = std::fs::remove_dir_all(&dir);
+        assert_eq!(n, Ok(2));
+        assert!(out.join("cells/c1.json").is_file() && out.join("cells/c2.json").is_file());
+        assert!(out.join("renders/c2.exr").is_file());
+        assert!(
+            !out.join("renders/c22.exr").is_file(),
+            "another cell's render"
+        );
+        let _ = std::fs::remove_dir_all(&base);
     }
 
     #[test]
-    fn merge_copies_cells_from_shards() {
-        let base = std::env::temp_dir().join(format!("xtask-merge-{}", std::process::id()));
+    fn merge_refuses_mixed_code_states_references_and_conflicts() {
+        let base = std::env::temp_dir().join(format!("xtask-merge-mix-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&base);
-        cell_file(&base.join("s1/cells"), "c1", "k", "r");
-        cell_file(&base.join("s2/cells"), "c2", "k", "r");
-        let mut notices = vec![];
         let out = base.join("out");
-        let n = merge_into(&[base.join("s1"), base.join("s2")], &out, &mut notices).unwrap();
-        assert_eq!(n, 2);
-        assert!(out.join("cells/c1.json").is_file() && out.join("cells/c2.json").is_file());
-        // again: nothing newer to copy
-        assert_eq!(
-            merge_into(&[base.join("s1")], &out, &mut notices).unwrap(),
-            0
-        );
+        let perm = Permissions::default();
+        let mixed = Permissions {
+            allow_mixed: true,
+            ..Permissions::default()
+        };
+        let mut notices = vec![];
+        // two shards of two code states
+        cell_file(&base.join("a/cells"), &cell_result("c1", "r", "tree:a"));
+        cell_file(&base.join("b/cells"), &cell_result("c2", "r", "tree:b"));
+        let both = [base.join("a"), base.join("b")];
+        let e = merge_into(&both, &out, &mut notices, &perm).unwrap_err();
+        assert!(e.contains("several code states"), "{e}");
+        assert!(!out.join("cells/c1.json").exists(), "nothing merged");
+        // two references of one scene
+        cell_file(&base.join("b/cells"), &cell_result("c2", "r2", "tree:a"));
+        let e = merge_into(&both, &out, &mut notices, &perm).unwrap_err();
+        assert!(e.contains("2 references"), "{e}");
+        // one cell with different results in two shards, whatever their file times
+        cell_file(&base.join("b/cells"), &cell_result("c1", "r", "tree:a"));
+        let mut other = cell_result("c1", "r", "tree:a");
+        other.spp = 5;
+        cell_file(&base.join("b/cells"), &other);
+        std::fs::remove_file(base.join("b/cells/c2.json")).unwrap();
+        let e = merge_into(&both, &out, &mut notices, &perm).unwrap_err();
+        assert!(e.contains("c1 differs"), "{e}");
+        // told: the one named last wins
+        assert_eq!(merge_into(&both, &out, &mut notices, &mixed), Ok(1));
+        assert_eq!(read_cell(&out.join("cells/c1.json")).unwrap().spp, 5);
+        // a dirty cell is refused unless allowed
+        let mut dirty = cell_result("c3", "r", "binary:1");
+        dirty.code = Some(code("binary:1", true));
+        cell_file(&base.join("d/cells"), &dirty);
+        let e = merge_into(&[base.join("d")], &base.join("out2"), &mut notices, &perm).unwrap_err();
+        assert!(e.contains("--allow-dirty"), "{e}");
         let _ = std::fs::remove_dir_all(&base);
     }
 }

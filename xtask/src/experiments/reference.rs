@@ -11,7 +11,9 @@ use render_core::metrics::error_metrics;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
-/// Bump when a renderer change alters images, so that every cached reference is rendered again.
+/// Bump to render every cached reference again by hand. Changes of the loaded scene (any file
+/// a loader reads, or how it understands materials) and of the reference strategy's
+/// parameters invalidate references on their own, through [`Validity`].
 pub const REFERENCE_EPOCH: u32 = 1;
 
 /// Relative and absolute squared error over a set of pixels.
@@ -56,12 +58,17 @@ impl Identity {
     }
 }
 
-/// Beyond the identity, what must still hold for a cached reference to be valid.
+/// Beyond the identity, what must still hold for a cached reference to be valid: the scene as
+/// loaded and the reference strategy as resolved, as the binary reports them. The code of the
+/// strategies is not part of it: any unbiased strategy converges to the same image.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct Validity {
-    /// Hash of the scene file's bytes and of `manylights info --json` (counts, power, bounds).
-    pub scene_content_hash: String,
-    pub manylights_version: String,
+    /// `manylights info --json`'s `scene_hash` (geometry, materials as understood, lights,
+    /// cameras: every file the loader read).
+    pub scene_hash: String,
+    /// `manylights strategy --json` of the reference strategy: its parameters, defaults
+    /// included, and the sampler.
+    pub strategy: serde_json::Value,
     pub epoch: u32,
 }
 
@@ -102,6 +109,8 @@ pub struct Reference {
     pub pixels: Vec<Vec3>,
     /// true where the camera sees no light.
     pub unlit: Vec<bool>,
+    /// Rendered by this run (not reused from the cache).
+    pub rendered: bool,
 }
 
 /// Why the cached reference in `dir` cannot be used (`Ok` = valid).
@@ -114,14 +123,11 @@ pub fn check(dir: &Path, identity: &Identity, validity: &Validity) -> Result<Man
     if &m.identity != identity {
         return Err("manifest is for another reference".into());
     }
-    if m.validity.scene_content_hash != validity.scene_content_hash {
-        return Err("the scene changed".into());
+    if m.validity.scene_hash != validity.scene_hash {
+        return Err("the loaded scene changed".into());
     }
-    if m.validity.manylights_version != validity.manylights_version {
-        return Err(format!(
-            "rendered by {}, now {}",
-            m.validity.manylights_version, validity.manylights_version
-        ));
+    if m.validity.strategy != validity.strategy {
+        return Err("the reference strategy's resolved parameters changed".into());
     }
     if m.validity.epoch != validity.epoch {
         return Err("reference epoch bumped".into());
@@ -145,18 +151,8 @@ pub fn load(dir: &Path, manifest: Manifest) -> Result<Reference, String> {
         manifest,
         pixels,
         unlit,
+        rendered: false,
     })
-}
-
-/// Scene content hash: the scene file's bytes (when it is a file) and its `info --json`.
-pub fn scene_content_hash(root: &Path, spec: &str, info: &serde_json::Value) -> String {
-    let mut bytes = serde_json::to_vec(info).unwrap_or_default();
-    if !spec.starts_with("builtin:")
-        && let Ok(file) = std::fs::read(root.join(spec))
-    {
-        bytes.extend(hex_hash(&file).as_bytes());
-    }
-    hex_hash(&bytes)
 }
 
 pub struct Ensure<'a> {
@@ -236,6 +232,12 @@ impl Ensure<'_> {
             let json = self.ml.render(&args, &out, &bar, None);
             bar.finish_and_clear();
             let json = json?;
+            if json["scene_hash"].as_str() != Some(self.validity.scene_hash.as_str()) {
+                return Err(Failure::Error(format!(
+                    "{name} rendered scene {}, not the one planned ({}): did a scene file change during the run?",
+                    json["scene_hash"], self.validity.scene_hash
+                )));
+            }
             wall += json["wall_seconds"].as_f64().unwrap_or(0.0);
             commit = json["git_commit"].as_str().map(str::to_string);
             let (w, h, px) = render_core::output::read_exr(&out).map_err(Failure::Error)?;
@@ -292,6 +294,7 @@ impl Ensure<'_> {
             manifest,
             pixels: avg,
             unlit,
+            rendered: true,
         })
     }
 }
@@ -315,8 +318,8 @@ mod tests {
 
     fn validity() -> Validity {
         Validity {
-            scene_content_hash: "abc".into(),
-            manylights_version: "manylights 0.1.0".into(),
+            scene_hash: "abc".into(),
+            strategy: serde_json::json!({ "strategy": "power+bsdf", "parameters": {} }),
             epoch: REFERENCE_EPOCH,
         }
     }
@@ -372,15 +375,19 @@ mod tests {
         other.spp = 128;
         assert!(check(&dir, &other, &validity()).is_err());
         let mut v = validity();
-        v.scene_content_hash = "changed".into();
+        v.scene_hash = "changed".into();
         assert!(
             check(&dir, &identity(), &v)
                 .unwrap_err()
                 .contains("scene changed")
         );
         let mut v = validity();
-        v.manylights_version = "manylights 0.2.0".into();
-        assert!(check(&dir, &identity(), &v).is_err());
+        v.strategy["parameters"] = serde_json::json!({ "tau": 0.5 });
+        assert!(
+            check(&dir, &identity(), &v)
+                .unwrap_err()
+                .contains("resolved parameters")
+        );
         let mut v = validity();
         v.epoch += 1;
         assert!(check(&dir, &identity(), &v).is_err());

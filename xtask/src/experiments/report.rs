@@ -1,6 +1,7 @@
 //! Cell results and what is made of them: cells.csv, cells.json, table.md, plots, strips.
 use super::config::BudgetClock;
 use super::plan::Budget;
+use super::provenance::{CellInputs, CodeState};
 use super::reference::Metric;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -34,6 +35,12 @@ pub struct CellResult {
     pub cpu_seconds: f64,
     /// The render's own JSON (stats, rays, technique samples, parameters, commit).
     pub render: serde_json::Value,
+    /// The code that rendered it (absent in cells from before it was recorded).
+    #[serde(default)]
+    pub code: Option<CodeState>,
+    /// The loaded scene, the strategy's resolved parameters and (time budgets) the threads.
+    #[serde(default)]
+    pub inputs: Option<CellInputs>,
 }
 
 impl CellResult {
@@ -130,9 +137,39 @@ pub fn speedup(e: &Entry, b: &Entry, budget: &Budget) -> Option<f64> {
     })
 }
 
+/// A cell whose relMSE is at most this many times its reference's own is flagged
+/// ([`REF_FLAG`]): the reference's noise is then a large part of what is measured, and
+/// speed-ups between such cells are understated.
+pub const REF_FLAG_FACTOR: f64 = 3.0;
+pub const REF_FLAG: &str = "°";
+
+/// The reference's own relMSE estimated from its half-vs-half relMSE `noise`: each half has
+/// twice the variance of their average, their difference four times it.
+pub fn reference_own(noise: f64) -> f64 {
+    noise / 4.0
+}
+
+/// Whether `e` is within [`REF_FLAG_FACTOR`] of the reference's own error (`noise` between halves).
+pub fn near_reference(e: &Entry, noise: Option<f64>) -> bool {
+    noise.is_some_and(|n| n > 0.0 && e.error.mean <= REF_FLAG_FACTOR * reference_own(n))
+}
+
+/// How many entries of a table are [`near_reference`].
+pub fn count_near_reference(
+    entries: &BTreeMap<(String, String), Entry>,
+    ref_noise: &BTreeMap<String, f64>,
+) -> usize {
+    entries
+        .iter()
+        .filter(|((r, _), e)| near_reference(e, ref_noise.get(r).copied()))
+        .count()
+}
+
 /// A paper-style markdown table: rows scenes, columns strategies (then the reference noise),
 /// mean ± std over seeds, the lowest error per row in bold, the speed-up vs the baseline column
-/// in parentheses.
+/// in parentheses, [`REF_FLAG`] on the entries [`near_reference`]; then the reference's
+/// half-vs-half relMSE and its own estimated relMSE; a row in `marks` has its mark after the
+/// scene's name.
 pub fn format_table(
     rows: &[String],
     cols: &[String],
@@ -140,6 +177,7 @@ pub fn format_table(
     baseline: &str,
     budget: &Budget,
     ref_noise: &BTreeMap<String, f64>,
+    marks: &BTreeMap<String, String>,
 ) -> String {
     let mut s = String::new();
     let _ = write!(s, "| scene |");
@@ -147,14 +185,21 @@ pub fn format_table(
         let mark = if c == baseline { " (baseline)" } else { "" };
         let _ = write!(s, " {c}{mark} |");
     }
-    let _ = writeln!(s, " ref. noise |");
+    let _ = writeln!(s, " ref. noise | ref. own |");
     let _ = write!(s, "|---|");
     for _ in cols {
         let _ = write!(s, "---:|");
     }
-    let _ = writeln!(s, "---:|");
+    let _ = writeln!(s, "---:|---:|");
     for r in rows {
-        let _ = write!(s, "| {r} |");
+        match marks.get(r) {
+            Some(m) => {
+                let _ = write!(s, "| {r} {m} |");
+            }
+            None => {
+                let _ = write!(s, "| {r} |");
+            }
+        }
         let row: Vec<Option<&Entry>> = cols
             .iter()
             .map(|c| entries.get(&(r.clone(), c.clone())))
@@ -183,16 +228,19 @@ pub fn format_table(
                     {
                         v = format!("{v} ({x:.2}×)");
                     }
+                    if near_reference(e, ref_noise.get(r).copied()) {
+                        v = format!("{v} {REF_FLAG}");
+                    }
                     let _ = write!(s, " {v} |");
                 }
             }
         }
         match ref_noise.get(r) {
             Some(n) => {
-                let _ = writeln!(s, " {} |", sci(*n));
+                let _ = writeln!(s, " {} | {} |", sci(*n), sci(reference_own(*n)));
             }
             None => {
-                let _ = writeln!(s, " – |");
+                let _ = writeln!(s, " – | – |");
             }
         }
     }
@@ -229,7 +277,7 @@ pub fn format_time_table(
     s
 }
 
-pub const CSV_HEADER: [&str; 26] = [
+pub const CSV_HEADER: [&str; 29] = [
     "id",
     "scene",
     "strategy",
@@ -256,6 +304,9 @@ pub const CSV_HEADER: [&str; 26] = [
     "technique_samples",
     "strategy_parameters",
     "git_commit",
+    "code_state",
+    "code_commit",
+    "code_dirty",
 ];
 
 pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), String> {
@@ -263,6 +314,7 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
         let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
         w.write_record(CSV_HEADER).map_err(|e| e.to_string())?;
         for c in cells {
+            let code = super::provenance::code_of(c);
             let (kind, value) = match c.budget {
                 Budget::Spp(n) => ("spp", n.to_string()),
                 Budget::Time(t) => ("time", t.to_string()),
@@ -294,6 +346,9 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
                 c.render["technique_samples"].to_string(),
                 c.render["strategy_parameters"].to_string(),
                 c.render["git_commit"].as_str().unwrap_or("").to_string(),
+                code.id.clone(),
+                code.commit.clone().unwrap_or_default(),
+                code.dirty.to_string(),
             ])
             .map_err(|e| e.to_string())?;
         }
@@ -331,23 +386,51 @@ mod tests {
         m.insert(("sceneB".into(), "ours".into()), e(0.03, 0.0, 1, 1.0));
         let noise = BTreeMap::from([("sceneA".to_string(), 0.0004)]);
         // equal spp: speed-up = (0.04 * 1) / (0.01 * 2) = 2
-        let t = format_table(&rows, &cols, &m, "E&K", &Budget::Spp(16), &noise);
+        let marks = BTreeMap::from([("sceneB".to_string(), "‡".to_string())]);
+        let t = format_table(&rows, &cols, &m, "E&K", &Budget::Spp(16), &noise, &marks);
         let lines: Vec<&str> = t.lines().collect();
         assert_eq!(
             lines[0],
-            "| scene | E&K (baseline) | ours | missing | ref. noise |"
+            "| scene | E&K (baseline) | ours | missing | ref. noise | ref. own |"
         );
         assert_eq!(
             lines[2],
-            "| sceneA | 4.00e-2 ± 4.00e-3 (1.00×) | **1.00e-2 ± 1.00e-3** (2.00×) | – | 4.00e-4 |"
+            "| sceneA | 4.00e-2 ± 4.00e-3 (1.00×) | **1.00e-2 ± 1.00e-3** (2.00×) | – | 4.00e-4 | 1.00e-4 |"
         );
         assert_eq!(
             lines[3],
-            "| sceneB | **2.00e-2** (1.00×) | 3.00e-2 (0.67×) | – | – |"
+            "| sceneB ‡ | **2.00e-2** (1.00×) | 3.00e-2 (0.67×) | – | – | – |"
         );
         // equal time: speed-up = error ratio = 4
-        let t = format_table(&rows, &cols, &m, "E&K", &Budget::Time(1.0), &noise);
+        let t = format_table(&rows, &cols, &m, "E&K", &Budget::Time(1.0), &noise, &marks);
         assert!(t.contains("**1.00e-2 ± 1.00e-3** (4.00×)"), "{t}");
+        assert_eq!(count_near_reference(&m, &noise), 0);
+    }
+
+    #[test]
+    fn cells_near_the_reference_error_are_flagged() {
+        let rows = vec!["s".to_string()];
+        let cols = vec!["a".to_string(), "b".to_string()];
+        // noise 4e-3 between halves: the reference's own 1e-3; 3× that = 3e-3
+        let noise = BTreeMap::from([("s".to_string(), 4e-3)]);
+        let mut m = BTreeMap::new();
+        m.insert(("s".into(), "a".into()), e(2.9e-3, 0.0, 1, 1.0));
+        m.insert(("s".into(), "b".into()), e(3.1e-3, 0.0, 1, 1.0));
+        let t = format_table(
+            &rows,
+            &cols,
+            &m,
+            "b",
+            &Budget::Spp(4),
+            &noise,
+            &BTreeMap::new(),
+        );
+        let row = t.lines().nth(2).unwrap();
+        assert_eq!(
+            row,
+            "| s | **2.90e-3** (1.07×) ° | 3.10e-3 (1.00×) | 4.00e-3 | 1.00e-3 |"
+        );
+        assert_eq!(count_near_reference(&m, &noise), 1);
     }
 
     #[test]

@@ -1,13 +1,15 @@
 //! `cargo xtask run-experiments`, one function per step: select the cells, check that their
-//! strategies and scenes exist, ensure the references, render and measure each cell, write the
-//! report (`super::finish`).
+//! strategies and scenes exist and ask the binary what they resolve to (`prepare`), ensure the
+//! references, render and measure each cell whose stored result is stale (`execute`), write
+//! the report (`super::finish`).
 use super::config::Experiment;
 use super::manylights::{self, Failure, Manylights, repo_root};
 use super::plan::{self, Budget, Cell};
+use super::provenance::{self, CellInputs, CodeState, Permissions};
 use super::reference::{self, Ensure, Identity, Reference, Validity};
 use super::report::CellResult;
-use super::{Notice, RunArgs, cell_key, finish, is_done, list, load_experiment, references_dir};
-use super::{results_dir, say};
+use super::{Notice, RunArgs, cell_key, finish, list, load_experiment, read_cell};
+use super::{references_dir, results_dir, say};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -20,49 +22,166 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
     }
     let exp = load_experiment(&args.experiment)?;
     let out = results_dir(&exp, &args.results);
-    let threads = args.threads.or(exp.threads);
-    let mut cells = select_cells(&exp, &args);
+    let cells = select_cells(&exp, &args);
     if args.dry_run {
         print_plan(&cells);
         return Ok(ExitCode::SUCCESS);
     }
-
     let start = Instant::now();
     let ml = Manylights::build()?;
-    let mut notices: Vec<Notice> = Vec::new();
-    let unavailable = unavailable_strategies(&exp, &ml, &mut notices)?;
-    let scene_hashes = available_scenes(&exp, &ml, &cells, &mut notices);
-    print_notices(&notices);
-    cells.retain(|c| {
-        scene_hashes.contains_key(&c.scene_label) && !unavailable.contains(&c.strategy.label)
-    });
-
-    let multi = MultiProgress::new();
-    let references = ensure_references(
+    let options = RunOptions {
+        threads: args.threads.or(exp.threads),
+        refresh_references: args.refresh_references,
+        rerender: args.rerender,
+        reuse_stale: args.reuse_stale,
+        references_only: args.references_only,
+    };
+    let prepared = prepare(&exp, &ml, cells, options.threads)?;
+    let perm = Permissions {
+        allow_dirty: args.allow_dirty,
+        allow_mixed: args.allow_mixed || args.reuse_stale,
+        current: Some(prepared.code.clone()),
+    };
+    let done = execute(
         &exp,
         &ml,
-        &cells,
-        &scene_hashes,
-        threads,
-        args.refresh_references,
-        &multi,
-        &mut notices,
+        prepared,
+        &out,
+        &references_dir(),
+        &options,
+        start,
     )?;
-    cells.retain(|c| references.contains_key(&c.scene_label));
-    if args.references_only {
-        return finish(&exp, &out, notices, start, false);
+    if !done.references_rendered.is_empty() {
+        eprintln!(
+            "references rendered: {}",
+            done.references_rendered.join(", ")
+        );
     }
+    let report = (!options.references_only).then_some(&perm);
+    finish(&exp, &out, done.notices, start, done.failed, report)
+}
 
+/// What a run was asked to do beyond the cells.
+#[derive(Clone, Debug, Default)]
+pub struct RunOptions {
+    pub threads: Option<usize>,
+    pub refresh_references: bool,
+    pub rerender: bool,
+    /// Keep finished cells of another code state when nothing else about them changed.
+    pub reuse_stale: bool,
+    pub references_only: bool,
+}
+
+/// The cells to run and everything that keys them, as the binary reports it.
+pub struct Prepared {
+    pub cells: Vec<Cell>,
+    pub notices: Vec<Notice>,
+    pub code: CodeState,
+    /// `scene_hash` by scene label (the scenes manylights can load).
+    pub scene_hashes: BTreeMap<String, String>,
+    /// Resolved parameters by strategy label (the strategies manylights can render).
+    pub strategies: BTreeMap<String, serde_json::Value>,
+    /// The reference strategy's resolved parameters.
+    pub reference_strategy: serde_json::Value,
+    /// Render threads, passed to every render.
+    pub threads: usize,
+}
+
+impl Prepared {
+    pub fn inputs(&self, cell: &Cell) -> CellInputs {
+        CellInputs::new(
+            &self.scene_hashes[&cell.scene_label],
+            &self.strategies[&cell.strategy.label],
+            self.threads,
+            &cell.budget,
+        )
+    }
+}
+
+/// Checks the cells' strategies and scenes against the binary and asks it for their keys;
+/// the cells it cannot render are dropped with a notice.
+pub fn prepare(
+    exp: &Experiment,
+    ml: &Manylights,
+    mut cells: Vec<Cell>,
+    threads: Option<usize>,
+) -> Result<Prepared, String> {
+    let mut notices: Vec<Notice> = Vec::new();
+    let strategies = available_strategies(exp, ml, &mut notices)?;
+    let scene_hashes = available_scenes(exp, ml, &cells, &mut notices);
+    print_notices(&notices);
+    cells.retain(|c| {
+        scene_hashes.contains_key(&c.scene_label) && strategies.contains_key(&c.strategy.label)
+    });
+    let reference_strategy = ml
+        .resolved_strategy(&exp.reference.strategy, &exp.reference.cli_args()?)
+        .map_err(|f| format!("reference strategy {}: {f}", exp.reference.strategy))?;
+    let threads = threads.unwrap_or_else(|| {
+        std::thread::available_parallelism()
+            .map(|n| n.get())
+            .unwrap_or(1)
+    });
+    Ok(Prepared {
+        cells,
+        notices,
+        code: provenance::code_state(&ml.root, &ml.exe)?,
+        scene_hashes,
+        strategies,
+        reference_strategy,
+        threads,
+    })
+}
+
+/// What a run did.
+pub struct Done {
+    pub notices: Vec<Notice>,
+    pub failed: bool,
+    /// Ids of the cells rendered, and of those kept from an earlier run.
+    pub rendered: Vec<String>,
+    pub reused: Vec<String>,
+    /// Directory names of the references rendered (not taken from the cache).
+    pub references_rendered: Vec<String>,
+}
+
+/// Ensures the references and renders every cell whose stored result is stale.
+pub fn execute(
+    exp: &Experiment,
+    ml: &Manylights,
+    mut p: Prepared,
+    out: &Path,
+    refs_dir: &Path,
+    options: &RunOptions,
+    start: Instant,
+) -> Result<Done, String> {
+    let multi = MultiProgress::new();
+    let mut notices = std::mem::take(&mut p.notices);
+    let references = ensure_references(exp, ml, &p, refs_dir, options, &multi, &mut notices)?;
+    let references_rendered = references
+        .values()
+        .filter(|r| r.rendered)
+        .filter_map(|r| r.dir.file_name().map(|n| n.to_string_lossy().into_owned()))
+        .collect();
+    p.cells.retain(|c| references.contains_key(&c.scene_label));
+    let mut done = Done {
+        notices,
+        failed: false,
+        rendered: vec![],
+        reused: vec![],
+        references_rendered,
+    };
+    if options.references_only {
+        return Ok(done);
+    }
     let renderer = CellRenderer {
-        ml: &ml,
-        exp: &exp,
+        ml,
+        exp,
+        prepared: &p,
         cells_dir: out.join("cells"),
         renders_dir: out.join("renders"),
-        threads,
-        rerender: args.rerender,
+        options,
     };
-    let failed = renderer.render_all(&cells, &references, &multi, &mut notices, start)?;
-    finish(&exp, &out, notices, start, failed)
+    renderer.render_all(&references, &multi, &mut done, start)?;
+    Ok(done)
 }
 
 /// The experiment's cells, narrowed by `--only` and `--shard`.
@@ -109,41 +228,49 @@ fn print_notices(notices: &[Notice]) {
     }
 }
 
-/// Labels of the experiment's strategies this manylights cannot render (unknown name, or a flag
-/// it does not take), each with a notice.
-fn unavailable_strategies(
+/// The resolved parameters of each of the experiment's strategies this manylights can render,
+/// by label; the others (unknown name, a flag it does not take) get a notice.
+fn available_strategies(
     exp: &Experiment,
     ml: &Manylights,
     notices: &mut Vec<Notice>,
-) -> Result<BTreeSet<String>, String> {
+) -> Result<BTreeMap<String, serde_json::Value>, String> {
     let known = ml.strategies()?;
     let help = ml.render_help();
-    let mut unavailable = BTreeSet::new();
+    let mut available = BTreeMap::new();
     for s in &exp.strategies {
+        let args = s.cli_args()?;
         let reason = if !known.contains(&s.name) {
-            Some(format!(
+            Some(Failure::Skip(format!(
                 "strategy `{}` is unknown to this manylights",
                 s.name
-            ))
+            )))
         } else {
-            let bad = manylights::unsupported_flags(&s.cli_args()?, &help);
-            (!bad.is_empty())
-                .then(|| format!("this manylights does not take {} yet", bad.join(", ")))
+            let bad = manylights::unsupported_flags(&args, &help);
+            (!bad.is_empty()).then(|| {
+                Failure::Skip(format!(
+                    "this manylights does not take {} yet",
+                    bad.join(", ")
+                ))
+            })
         };
-        if let Some(message) = reason {
-            notices.push(Notice {
-                what: format!("strategy {}", s.label),
-                skipped: true,
-                message,
-            });
-            unavailable.insert(s.label.clone());
+        let resolved = match reason {
+            Some(f) => Err(f),
+            None => ml.resolved_strategy(&s.name, &args),
+        };
+        match resolved {
+            Ok(v) => {
+                available.insert(s.label.clone(), v);
+            }
+            Err(f) => notices.push(failure_notice(format!("strategy {}", s.label), f)),
         }
     }
-    Ok(unavailable)
+    Ok(available)
 }
 
-/// Content hash of every scene some cell needs and manylights can load, by label; absent
-/// scene files and failed `info` calls become notices.
+/// The loaded scene's hash (`manylights info --json`'s `scene_hash`) of every scene some cell
+/// needs and manylights can load, by label; absent scene files and failed `info` calls
+/// become notices.
 fn available_scenes(
     exp: &Experiment,
     ml: &Manylights,
@@ -166,9 +293,17 @@ fn available_scenes(
             });
             continue;
         }
-        match ml.info(&s.spec) {
-            Ok(info) => {
-                hashes.insert(label, reference::scene_content_hash(&root, &s.spec, &info));
+        let hash = ml.info(&s.spec).and_then(|info| {
+            info["scene_hash"]
+                .as_str()
+                .map(str::to_string)
+                .ok_or_else(|| {
+                    Failure::Error("this manylights's `info --json` has no scene_hash".into())
+                })
+        });
+        match hash {
+            Ok(h) => {
+                hashes.insert(label, h);
             }
             Err(f) => notices.push(failure_notice(format!("scene {label}"), f)),
         }
@@ -178,29 +313,25 @@ fn available_scenes(
 
 /// The valid cached reference of every scene some cell needs, rendering the missing or stale
 /// ones; a scene whose reference fails gets a notice and no entry.
-#[allow(clippy::too_many_arguments)]
 fn ensure_references(
     exp: &Experiment,
     ml: &Manylights,
-    cells: &[Cell],
-    scene_hashes: &BTreeMap<String, String>,
-    threads: Option<usize>,
-    refresh: bool,
+    p: &Prepared,
+    refs_dir: &Path,
+    options: &RunOptions,
     multi: &MultiProgress,
     notices: &mut Vec<Notice>,
 ) -> Result<BTreeMap<String, Reference>, String> {
-    let refs_dir = references_dir();
-    let version = ml.version();
     let mut references = BTreeMap::new();
     for s in &exp.scenes {
         let label = s.label();
-        if !cells.iter().any(|c| c.scene_label == label) {
+        if !p.cells.iter().any(|c| c.scene_label == label) {
             continue;
         }
         let (width, height) = plan::scene_resolution(exp, s);
         let ensure = Ensure {
             ml,
-            refs_dir: &refs_dir,
+            refs_dir,
             identity: Identity {
                 scene: s.spec.clone(),
                 camera: s.camera.clone(),
@@ -212,12 +343,12 @@ fn ensure_references(
                 height,
             },
             validity: Validity {
-                scene_content_hash: scene_hashes[&label].clone(),
-                manylights_version: version.clone(),
+                scene_hash: p.scene_hashes[&label].clone(),
+                strategy: p.reference_strategy.clone(),
                 epoch: reference::REFERENCE_EPOCH,
             },
-            threads,
-            force: refresh,
+            threads: Some(p.threads),
+            force: options.refresh_references,
         };
         match ensure.run(multi) {
             Ok(r) => {
@@ -279,10 +410,10 @@ fn style(template: &str) -> ProgressStyle {
 struct CellRenderer<'a> {
     ml: &'a Manylights,
     exp: &'a Experiment,
+    prepared: &'a Prepared,
     cells_dir: PathBuf,
     renders_dir: PathBuf,
-    threads: Option<usize>,
-    rerender: bool,
+    options: &'a RunOptions,
 }
 
 /// What became of one rendered cell.
@@ -293,30 +424,45 @@ enum Outcome {
     Failed,
 }
 
+/// Whether a stored cell can be kept for `cell`: the same plan, reference, loaded scene,
+/// resolved strategy and (time budgets) threads, and the same code unless `reuse_stale`.
+pub fn is_current(
+    stored: &CellResult,
+    cell: &Cell,
+    reference_id: &str,
+    inputs: &CellInputs,
+    code: &CodeState,
+    reuse_stale: bool,
+) -> bool {
+    stored.key == cell_key(cell)
+        && stored.reference == reference_id
+        && stored.inputs.as_ref() == Some(inputs)
+        && (reuse_stale || stored.code.as_ref() == Some(code))
+}
+
 impl CellRenderer<'_> {
-    /// Every cell in order, with progress bars; true when some cell failed.
+    /// Every cell in order, with progress bars, into `done`.
     fn render_all(
         &self,
-        cells: &[Cell],
         references: &BTreeMap<String, Reference>,
         multi: &MultiProgress,
-        notices: &mut Vec<Notice>,
+        done: &mut Done,
         start: Instant,
-    ) -> Result<bool, String> {
+    ) -> Result<(), String> {
         for d in [&self.cells_dir, &self.renders_dir] {
             std::fs::create_dir_all(d)
                 .map_err(|e| format!("cannot create {}: {e}", d.display()))?;
         }
+        let cells = &self.prepared.cells;
         let total = multi.add(ProgressBar::new(cells.len() as u64));
         total.set_style(style(
             "cells {pos}/{len} {wide_bar} [{elapsed_precise}, eta {eta}]",
         ));
-        let (mut rendered, mut reused, mut failed) = (0usize, 0usize, false);
         let mut skipped_strategies: BTreeSet<String> = BTreeSet::new();
         for cell in cells {
             let reference = &references[&cell.scene_label];
             if self.is_finished(cell, reference) {
-                reused += 1;
+                done.reused.push(cell.id());
                 total.inc(1);
                 continue;
             }
@@ -324,27 +470,39 @@ impl CellRenderer<'_> {
                 total.inc(1);
                 continue;
             }
-            match self.render_one(cell, reference, multi, &total, notices)? {
-                Outcome::Rendered => rendered += 1,
+            match self.render_one(cell, reference, multi, &total, &mut done.notices)? {
+                Outcome::Rendered => done.rendered.push(cell.id()),
                 Outcome::Skipped => {
                     skipped_strategies.insert(cell.strategy.label.clone());
                 }
-                Outcome::Failed => failed = true,
+                Outcome::Failed => done.failed = true,
             }
             total.inc(1);
         }
         total.finish_and_clear();
         eprintln!(
-            "{rendered} cells rendered, {reused} reused from an earlier run, in {:.1} s",
+            "{} cells rendered, {} reused from an earlier run, in {:.1} s",
+            done.rendered.len(),
+            done.reused.len(),
             start.elapsed().as_secs_f64()
         );
-        Ok(failed)
+        Ok(())
     }
 
-    /// Whether the cell's result of an earlier run can be kept (same plan key and reference).
+    /// Whether the cell's result of an earlier run can be kept (see [`is_current`]).
     fn is_finished(&self, cell: &Cell, reference: &Reference) -> bool {
         let path = self.cells_dir.join(format!("{}.json", cell.id()));
-        !self.rerender && is_done(&path, &cell_key(cell), &reference.manifest.content_id())
+        !self.options.rerender
+            && read_cell(&path).is_some_and(|stored| {
+                is_current(
+                    &stored,
+                    cell,
+                    &reference.manifest.content_id(),
+                    &self.prepared.inputs(cell),
+                    &self.prepared.code,
+                    self.options.reuse_stale,
+                )
+            })
     }
 
     /// Renders and measures the cell, and writes its result.
@@ -357,10 +515,8 @@ impl CellRenderer<'_> {
         notices: &mut Vec<Notice>,
     ) -> Result<Outcome, String> {
         let id = cell.id();
-        let key = cell_key(cell);
-        let ref_id = reference.manifest.content_id();
         let path = self.cells_dir.join(format!("{id}.json"));
-        let cmd = render_args(cell, self.threads)?;
+        let cmd = render_args(cell, Some(self.prepared.threads))?;
         let expected = match cell.budget {
             Budget::Spp(_) => None,
             Budget::Time(t) => Some(t),
@@ -395,7 +551,15 @@ impl CellRenderer<'_> {
                 });
             }
         };
-        match measure(cell, &exr, reference, json, &self.exp.name, key, ref_id) {
+        let inputs = self.prepared.inputs(cell);
+        let measured = check_render(&json, &inputs).and_then(|()| {
+            measure(cell, &exr, reference, json, &self.exp.name).map(|mut r| {
+                r.code = Some(self.prepared.code.clone());
+                r.inputs = Some(inputs);
+                r
+            })
+        });
+        match measured {
             Ok(r) => {
                 render_core::output::write_json(&path, &serde_json::to_value(&r).unwrap())?;
                 say(
@@ -420,6 +584,24 @@ impl CellRenderer<'_> {
     }
 }
 
+/// That the render used the scene and strategy the cell is keyed by (a file edited during
+/// the run, or a binary that resolves differently from `manylights strategy`, is an error).
+fn check_render(render: &serde_json::Value, inputs: &CellInputs) -> Result<(), String> {
+    if render["scene_hash"].as_str() != Some(inputs.scene_hash.as_str()) {
+        return Err(format!(
+            "the render loaded scene {}, not the one planned ({}): did a scene file change during the run?",
+            render["scene_hash"], inputs.scene_hash
+        ));
+    }
+    if render["resolved_strategy"] != inputs.strategy {
+        return Err(format!(
+            "the render resolved the strategy to {}, `manylights strategy` to {}",
+            render["resolved_strategy"], inputs.strategy
+        ));
+    }
+    Ok(())
+}
+
 /// The cell's errors against its reference, over all pixels and over the unlit ones.
 fn measure(
     cell: &Cell,
@@ -427,8 +609,6 @@ fn measure(
     reference: &Reference,
     render: serde_json::Value,
     experiment: &str,
-    key: String,
-    ref_id: String,
 ) -> Result<CellResult, String> {
     let (w, h, px) = render_core::output::read_exr(exr)?;
     if (w, h)
@@ -455,7 +635,7 @@ fn measure(
         render_core::metrics::error_metrics(&px, &reference.pixels, Some(&unlit_pixels)).into();
     Ok(CellResult {
         id: cell.id(),
-        key,
+        key: cell_key(cell),
         experiment: experiment.to_string(),
         scene: cell.scene_label.clone(),
         scene_spec: cell.scene.spec.clone(),
@@ -466,7 +646,7 @@ fn measure(
         seed: cell.seed,
         width: w,
         height: h,
-        reference: ref_id,
+        reference: reference.manifest.content_id(),
         reference_dir: reference
             .dir
             .file_name()
@@ -479,5 +659,7 @@ fn measure(
         wall_seconds: render["wall_seconds"].as_f64().unwrap_or(0.0),
         cpu_seconds: render["cpu_seconds"].as_f64().unwrap_or(0.0),
         render,
+        code: None,
+        inputs: None,
     })
 }

@@ -1,0 +1,217 @@
+//! What made a cell: the code state of the binary, the loaded scene, the strategy's resolved
+//! parameters and (for time budgets) the thread count; and the checks the report and
+//! `merge-results` make before writing one table from many cells.
+use super::plan::{Budget, hex_hash};
+use super::report::CellResult;
+use serde::{Deserialize, Serialize};
+use std::collections::{BTreeMap, BTreeSet};
+use std::path::Path;
+use std::process::Command;
+
+/// The paths whose content determines the `manylights` binary: a clean tree at two commits
+/// that agree on them is one code state (a commit that only adds results re-renders nothing).
+pub const CODE_PATHS: [&str; 4] = ["crates", "Cargo.toml", "Cargo.lock", ".cargo"];
+
+/// The code a cell was rendered by.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq, Eq, PartialOrd, Ord)]
+pub struct CodeState {
+    /// `tree:<hash of the git objects of CODE_PATHS>` for a clean tree, `binary:<hash of the
+    /// manylights executable>` for a dirty one (or outside git).
+    pub id: String,
+    /// HEAD when the cell was rendered (12 hex digits), if in git.
+    pub commit: Option<String>,
+    /// Some file under CODE_PATHS differed from HEAD.
+    pub dirty: bool,
+}
+
+impl CodeState {
+    /// How a table header names it.
+    pub fn describe(&self) -> String {
+        match (&self.commit, self.dirty) {
+            (Some(c), false) => format!("commit {c}"),
+            (Some(c), true) => format!("a dirty tree on {c} ({})", self.id),
+            (None, _) => format!("a build outside git ({})", self.id),
+        }
+    }
+
+    /// The code state of a cell written before cells recorded one: its render's commit.
+    pub fn legacy(render: &serde_json::Value) -> CodeState {
+        let commit = render["git_commit"].as_str().unwrap_or("unknown");
+        let dirty = commit.ends_with("-dirty") || commit == "unknown";
+        CodeState {
+            id: format!("legacy:{commit}"),
+            commit: Some(commit.trim_end_matches("-dirty").to_string()),
+            dirty,
+        }
+    }
+}
+
+fn git(root: &Path, args: &[&str]) -> Option<String> {
+    let out = Command::new("git")
+        .args(args)
+        .current_dir(root)
+        .output()
+        .ok()?;
+    out.status
+        .success()
+        .then(|| String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// The code state of the tree at `root`, whose `manylights` binary is `exe`.
+pub fn code_state(root: &Path, exe: &Path) -> Result<CodeState, String> {
+    let commit = git(root, &["rev-parse", "--short=12", "HEAD"]).map(|s| s.trim().to_string());
+    let mut status_args = vec!["status", "--porcelain", "--untracked-files=no", "--"];
+    status_args.extend(CODE_PATHS);
+    let clean = git(root, &status_args).map(|s| s.trim().is_empty());
+    if let (Some(commit), Some(true)) = (&commit, clean) {
+        // HEAD:path for each path that exists at HEAD (.cargo may not).
+        let objects: Vec<String> = CODE_PATHS
+            .iter()
+            .filter_map(|p| git(root, &["rev-parse", &format!("HEAD:{p}")]))
+            .map(|s| s.trim().to_string())
+            .collect();
+        return Ok(CodeState {
+            id: format!("tree:{}", hex_hash(objects.join(" ").as_bytes())),
+            commit: Some(commit.clone()),
+            dirty: false,
+        });
+    }
+    let bytes =
+        std::fs::read(exe).map_err(|e| format!("cannot read {} to hash it: {e}", exe.display()))?;
+    Ok(CodeState {
+        id: format!("binary:{}", hex_hash(&bytes)),
+        commit,
+        dirty: true,
+    })
+}
+
+/// What besides the plan and the code determines a cell's image, as the binary reports it.
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct CellInputs {
+    /// `manylights info --json`'s `scene_hash`: the loaded scene.
+    pub scene_hash: String,
+    /// `manylights strategy --json`: the strategy's every parameter and the sampler.
+    pub strategy: serde_json::Value,
+    /// Render threads, for time budgets only (an spp render is the same on any count).
+    pub threads: Option<usize>,
+}
+
+impl CellInputs {
+    pub fn new(
+        scene_hash: &str,
+        strategy: &serde_json::Value,
+        threads: usize,
+        budget: &Budget,
+    ) -> Self {
+        CellInputs {
+            scene_hash: scene_hash.to_string(),
+            strategy: strategy.clone(),
+            threads: matches!(budget, Budget::Time(_)).then_some(threads),
+        }
+    }
+}
+
+/// The code state a cell records (the render's commit for cells from before).
+pub fn code_of(c: &CellResult) -> CodeState {
+    c.code
+        .clone()
+        .unwrap_or_else(|| CodeState::legacy(&c.render))
+}
+
+/// What the report may write a table from.
+#[derive(Clone, Debug, Default)]
+pub struct Permissions {
+    /// Cells rendered by a dirty build (the header then says so).
+    pub allow_dirty: bool,
+    /// Cells of several code states, or one scene's cells measured against several references
+    /// (each such row is then marked).
+    pub allow_mixed: bool,
+    /// The code state of this run (`run-experiments`); cells of another are the marked ones.
+    /// `None` (`merge-results`): the state most cells have.
+    pub current: Option<CodeState>,
+}
+
+/// The code states and references behind a set of cells, checked.
+#[derive(Clone, Debug, Default)]
+pub struct Provenance {
+    /// The table's code state and every other one with its cell count.
+    pub main: Option<CodeState>,
+    pub states: BTreeMap<CodeState, usize>,
+    /// Scenes whose row mixes code states or references, with why.
+    pub mixed_rows: BTreeMap<String, String>,
+    pub dirty: bool,
+}
+
+impl Provenance {
+    /// The check: refuses dirty cells and mixtures unless `perm` allows them.
+    pub fn check(cells: &[CellResult], perm: &Permissions) -> Result<Provenance, String> {
+        let mut states: BTreeMap<CodeState, usize> = BTreeMap::new();
+        for c in cells {
+            *states.entry(code_of(c)).or_default() += 1;
+        }
+        let main = perm.current.clone().or_else(|| {
+            states
+                .iter()
+                .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(a.0)))
+                .map(|(s, _)| s.clone())
+        });
+        let dirty = states.keys().any(|s| s.dirty);
+        if dirty && !perm.allow_dirty {
+            let which: Vec<String> = states
+                .keys()
+                .filter(|s| s.dirty)
+                .map(CodeState::describe)
+                .collect();
+            return Err(format!(
+                "refusing to write a table from cells rendered by {}: commit the code and render \
+                 again, or pass --allow-dirty (the table then says so)",
+                which.join(", ")
+            ));
+        }
+        let mut mixed_rows: BTreeMap<String, String> = BTreeMap::new();
+        let mut by_scene: BTreeMap<&str, (BTreeSet<String>, BTreeSet<&str>)> = BTreeMap::new();
+        for c in cells {
+            let e = by_scene.entry(c.scene.as_str()).or_default();
+            e.0.insert(code_of(c).id);
+            e.1.insert(c.reference.as_str());
+        }
+        for (scene, (codes, refs)) in &by_scene {
+            let mut why = Vec::new();
+            let other_code = main
+                .as_ref()
+                .is_some_and(|m| codes.iter().any(|c| c != &m.id));
+            if other_code {
+                why.push("cells of another code state".to_string());
+            }
+            if refs.len() > 1 {
+                why.push(format!("{} references", refs.len()));
+            }
+            if !why.is_empty() {
+                mixed_rows.insert(scene.to_string(), why.join(", "));
+            }
+        }
+        if !mixed_rows.is_empty() && !perm.allow_mixed {
+            let list: Vec<String> = mixed_rows
+                .iter()
+                .map(|(s, w)| format!("{s} ({w})"))
+                .collect();
+            return Err(format!(
+                "refusing to write one table from several code states or references: {}; \
+                 code states: {}. Render again at one code state (--rerender), or pass \
+                 --allow-mixed (--reuse-stale for a run) to mark those rows",
+                list.join("; "),
+                states
+                    .iter()
+                    .map(|(s, n)| format!("{} ({n} cells)", s.describe()))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ));
+        }
+        Ok(Provenance {
+            main,
+            states,
+            mixed_rows,
+            dirty,
+        })
+    }
+}
