@@ -13,6 +13,8 @@
 //!   node with any node importance.
 //! * [`LightTree::cut`] / [`LightTree::adaptive_cut`]: cuts for adaptive tree splitting, with
 //!   the authors' E&K criterion in scene units or our unit-free one ([`SplitCriterion`]).
+//! * [`SgNodes::build`]: the spherical-Gaussian light of every node (Tokuyoshi et al. 2024),
+//!   fitted bottom-up from one [`SgEmitter`] per light, beside the nodes.
 //!
 //! A descent that reaches a node whose two children both have zero importance returns `None`
 //! (with conservative bounds, every light below is dark at `x`), so Σ pmf over all lights is
@@ -68,6 +70,9 @@
 mod build;
 mod cone;
 mod query;
+mod sg;
+#[cfg(test)]
+mod sg_tests;
 #[cfg(test)]
 mod split_tests;
 #[cfg(test)]
@@ -75,6 +80,9 @@ mod tests;
 
 pub use cone::Cone;
 pub use query::{Cut, DescentRandom, Fresh, Rescaled, SplitCriterion, SplitParams};
+pub use sg::{
+    SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,
+};
 
 use glam::Vec3;
 use std::fmt;
@@ -169,6 +177,18 @@ pub enum BuildError {
         /// Index of the rejected light.
         light: usize,
     },
+    /// [`SgNodes::build`] got another number of emitters than the tree has lights.
+    EmitterCount {
+        /// Lights in the tree.
+        lights: usize,
+        /// Emitters given.
+        emitters: usize,
+    },
+    /// An [`SgEmitter`] with a negative variance or a mean direction longer than 1.
+    BadEmitter {
+        /// Index of the rejected emitter.
+        light: usize,
+    },
 }
 
 impl fmt::Display for BuildError {
@@ -197,6 +217,18 @@ impl fmt::Display for BuildError {
                 write!(
                     f,
                     "light tree: light {light} has a zero axis but theta_o < pi"
+                )
+            }
+            BuildError::EmitterCount { lights, emitters } => {
+                write!(
+                    f,
+                    "light tree: {emitters} SG emitters given for {lights} lights"
+                )
+            }
+            BuildError::BadEmitter { light } => {
+                write!(
+                    f,
+                    "light tree: SG emitter {light} has a negative variance or a mean direction longer than 1"
                 )
             }
         }

@@ -33,6 +33,7 @@ pub mod resolve;
 pub mod ris;
 mod scratch;
 pub mod selection;
+pub mod sg;
 pub mod tree_selection;
 
 use light_strategy::{BsdfStrategy, LightStrategy};
@@ -207,6 +208,11 @@ pub fn strategies() -> Vec<StrategyInfo> {
             "adaptive tree splitting + BSDF sampling, MIS (the paper's E&K baseline)",
         ),
         s(
+            "sg-tree",
+            "light tree, single descent by spherical-Gaussian BRDF-aware importance (Tokuyoshi et al. 2024)",
+        ),
+        s("sg-tree+bsdf", "sg-tree + BSDF sampling, MIS"),
+        s(
             "brdf-oriented",
             "BRDF-oriented light sampling alone (not complete: see docs)",
         ),
@@ -287,6 +293,15 @@ pub fn create(
         "tree+bsdf" => tree(TreeMode::Single, true)?,
         "tree-split" => tree(split, false)?,
         "tree-split+bsdf" => tree(split, true)?,
+        "sg-tree" | "sg-tree+bsdf" => Box::new(LightStrategy {
+            name: name.into(),
+            selection: sg::SgTreeSelection::new(scene, units).map_err(StrategyError::BadOption)?,
+            with_bsdf: name == "sg-tree+bsdf",
+            parameters: serde_json::json!({
+                "reproduce": opts.reproduce,
+                "floor": sg::importance::FLOOR,
+            }),
+        }),
         "uniform" => Box::new(LightStrategy {
             name: name.into(),
             selection: UniformSelection::new(scene),

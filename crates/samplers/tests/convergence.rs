@@ -52,6 +52,8 @@ fn baseline_strategies_agree_on_a_mixed_scene() {
         ("tree+bsdf", 256),
         ("tree-split", 128),
         ("tree-split+bsdf", 128),
+        ("sg-tree", 256),
+        ("sg-tree+bsdf", 256),
     ] {
         let r = render_with(&scene, name, spp, 2, 2);
         let failures = compare(&reference, &r, 2, 3.0);
@@ -89,7 +91,8 @@ fn every_sampler_converges_to_the_same_image() {
     }
 }
 
-/// The oracle and the RIS strategies (issue 13) against power+bsdf, on the mixed scene and on
+/// The oracle and the RIS strategies (issue 13), and the SG tree with BSDF sampling (issue 24),
+/// against power+bsdf, on the mixed scene and on
 /// glossy spheres (rough enough for 32 spp to be past the heavy-tailed regime, see method.rs).
 #[test]
 fn oracle_and_ris_agree_with_power_bsdf() {
@@ -103,7 +106,14 @@ fn oracle_and_ris_agree_with_power_bsdf() {
         [(&mixed, 256, 64, None), (&spheres, 512, 32, Some((32, 24)))]
     {
         let reference = render_sized(scene, "power+bsdf", ref_spp, 2, 1, size);
-        for name in ["oracle", "ris", "ris-1", "ris-32", "ris-adaptive"] {
+        for name in [
+            "oracle",
+            "ris",
+            "ris-1",
+            "ris-32",
+            "ris-adaptive",
+            "sg-tree+bsdf",
+        ] {
             let r = render_sized(scene, name, spp, 2, 2, size);
             let failures = compare(&reference, &r, 2, 3.0);
             assert!(
@@ -169,7 +179,11 @@ fn image_is_identical_for_any_thread_count() {
     assert!(a.pixels != c.pixels, "another seed gives another image");
     // The strategies with per-thread scratch (cuts, memoised importances) too.
     // mis3-adaptive at 4 spp: its N_max chosen after passes 2 and 3 acts on passes 3 and 4.
-    for (name, spp) in [("tree-split+bsdf", 2), ("mis3-adaptive", 4)] {
+    for (name, spp) in [
+        ("tree-split+bsdf", 2),
+        ("mis3-adaptive", 4),
+        ("sg-tree+bsdf", 2),
+    ] {
         let a = render_with(&scene, name, spp, 1, 7);
         let b = render_with(&scene, name, spp, 2, 7);
         assert_bit_identical(&a, &b, name);
