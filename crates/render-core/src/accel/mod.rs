@@ -18,6 +18,9 @@ use obvhs::aabb::Aabb;
 use obvhs::{BvhBuildParams, bvh2::builder::build_bvh2};
 use std::time::Duration;
 
+/// Most primitives in a leaf of obvhs's build.
+const LEAF_PRIMS: u32 = 4;
+
 /// A primitive as the BVH sees it.
 #[derive(Clone, Copy, Debug)]
 pub enum Primitive {
@@ -91,7 +94,11 @@ impl Accel {
             .collect();
         let bvh2 = build_bvh2(
             &aabbs,
-            BvhBuildParams::medium_build(),
+            BvhBuildParams {
+                // One packet of four: a leaf costs one 4-lane test.
+                max_prims_per_leaf: LEAF_PRIMS,
+                ..BvhBuildParams::medium_build()
+            },
             &mut Duration::default(),
         );
         let wide = collapse::collapse(&bvh2, prims);
