@@ -8,8 +8,11 @@ use render_core::rng::SampleStream;
 use render_core::sampling::cosine_hemisphere;
 use render_core::scene::{Scene, offset_origin, ray_epsilon};
 
+/// A hit's primitive and the bits of its distance and barycentrics.
+type HitBits = Option<(u32, u32, u32, u32)>;
+
 /// (closest hits of camera and bounce rays, occlusion of shadow rays) at 48×48 pixels.
-fn trace(scene: &Scene) -> (Vec<Option<(u32, u32, u32, u32)>>, Vec<bool>) {
+fn trace(scene: &Scene) -> (Vec<HitBits>, Vec<bool>) {
     let cam = scene.camera(None).unwrap();
     let bits = |h: Option<Hit>| h.map(|h| (h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()));
     let (mut hits, mut blocked) = (Vec::new(), Vec::new());
