@@ -126,6 +126,9 @@ impl Accel {
     /// Closest hit with t in [tmin, tmax).
     pub fn intersect(&self, origin: Vec3, dir: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
         let w = self.wide.as_ref()?;
+        if !(origin.is_finite() && dir.is_finite()) {
+            return None; // NaN distances would pass every box test and find nothing.
+        }
         let dir = positive_zeros(dir);
         traverse::with_stack(self.stack_need, |stack| match self.simd {
             #[cfg(target_arch = "x86_64")]
@@ -140,6 +143,9 @@ impl Accel {
         let Some(w) = self.wide.as_ref() else {
             return false;
         };
+        if !(origin.is_finite() && dir.is_finite()) {
+            return false;
+        }
         let dir = positive_zeros(dir);
         traverse::with_stack(self.stack_need, |stack| match self.simd {
             #[cfg(target_arch = "x86_64")]

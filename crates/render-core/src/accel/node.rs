@@ -39,7 +39,8 @@ pub fn leaf_parts(code: u32) -> (u32, u32, u32) {
     )
 }
 
-/// Eight children's boxes and codes; unused slots have empty boxes (min +∞, max −∞).
+/// Eight children's boxes and codes; unused slots have empty boxes (min +∞, max −∞) and
+/// empty leaves.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 pub struct Node8 {
@@ -56,7 +57,9 @@ impl Node8 {
         }
         Node8 {
             bounds,
-            child: [0; 8],
+            // An empty leaf: a ray whose NaN distances pass every box test finds nothing
+            // there (code 0 would be the root, and a loop).
+            child: [LEAF; 8],
         }
     }
 

@@ -205,3 +205,32 @@ fn forcing_avx2_without_it_is_an_error() {
     );
     assert!(!a.occluded(Vec3::ZERO, Vec3::Z, 0.0, f32::INFINITY));
 }
+
+#[test]
+fn non_finite_and_far_away_rays_end_without_a_loop() {
+    // A NaN direction passes every box test (NaN distances are kept conservative): the
+    // empty child slots must not lead anywhere, and such rays find nothing.
+    let mut rng = Rng(7);
+    let prims = soup(&mut rng);
+    let mut sse = Accel::build(&prims);
+    sse.set_simd(Simd::Sse2).unwrap();
+    let fast = Accel::build(&prims);
+    for (o, d) in [
+        (Vec3::ZERO, Vec3::NAN),
+        (Vec3::new(f32::INFINITY, 0.0, 0.0), -Vec3::X),
+        (Vec3::new(0.0, 0.0, 1e30), -Vec3::Z),
+        (Vec3::new(3.0, 2.0, 1e30), Vec3::new(0.0, 0.0, -1.0)),
+    ] {
+        for a in [&fast, &sse] {
+            let h = a.intersect(o, d, 0.0, f32::INFINITY);
+            assert_eq!(bits(h), bits(fast.intersect(o, d, 0.0, f32::INFINITY)));
+            assert_eq!(
+                a.occluded(o, d, 0.0, f32::INFINITY),
+                fast.occluded(o, d, 0.0, f32::INFINITY)
+            );
+            if !(o.is_finite() && d.is_finite()) {
+                assert!(h.is_none());
+            }
+        }
+    }
+}
