@@ -1,10 +1,16 @@
-//! Closest-hit and shadow-ray throughput on a scene of over a million triangles
-//! (a field of tessellated spheres over a ground plane, seen by a pinhole camera).
+//! Closest-hit and shadow-ray throughput, one thread: coherent camera rays and their shadow
+//! rays on a scene of over a million triangles (a field of tessellated spheres over a ground
+//! plane, seen by a pinhole camera), and incoherent secondary rays of `builtin:emissive-mesh`
+//! (from its camera rays' shading points: shadow rays to random points on random lights, and
+//! cosine-distributed BSDF rays traced for their closest hit).
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec2, Vec3};
 use render_core::camera::Camera;
+use render_core::frame::Frame;
 use render_core::material::Material;
-use render_core::scene::{Scene, SceneBuilder};
+use render_core::rng::SampleStream;
+use render_core::sampling::cosine_hemisphere;
+use render_core::scene::{Scene, SceneBuilder, offset_origin};
 
 /// A UV sphere mesh with `n` segments and `n/2` rings (about n² triangles).
 fn sphere_mesh(n: u32) -> (Vec<Vec3>, Vec<u32>) {
@@ -129,5 +135,86 @@ fn bench_rays(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, bench_rays);
+/// A ray as the benchmark stores it: origin, unit direction and the segment's far end.
+struct Segment {
+    o: Vec3,
+    d: Vec3,
+    tmax: f32,
+}
+
+/// Shadow and BSDF rays from the shading points of `builtin:emissive-mesh`'s camera rays
+/// (one light sample and one BSDF direction per 256×256 pixel), in pixel order: each ray's
+/// neighbours start nearby but head anywhere.
+fn emissive_mesh_rays() -> (Scene, Vec<Segment>, Vec<Segment>) {
+    let scene = scene_formats::load_scene("builtin:emissive-mesh", None).unwrap();
+    let cam = scene.camera(None).unwrap();
+    let (w, h) = (256u32, 256u32);
+    let aspect = w as f32 / h as f32;
+    let (mut shadow, mut bsdf) = (Vec::new(), Vec::new());
+    for pixel in 0..w * h {
+        let mut rng = SampleStream::new(7, pixel as u64, 0);
+        let film = Vec2::new(
+            ((pixel % w) as f32 + 0.5) / w as f32,
+            ((pixel / w) as f32 + 0.5) / h as f32,
+        );
+        let dir = cam.ray_direction(film, aspect);
+        let Some(hit) = scene.intersect(cam.position, dir, 0.0, f32::INFINITY) else {
+            continue;
+        };
+        if hit.material.is_none() || scene.lights.is_empty() {
+            continue;
+        }
+        let light = (rng.next_f32() * scene.lights.len() as f32) as u32;
+        let light = light.min(scene.lights.len() as u32 - 1);
+        if let Some(s) = scene.sample_light(light, hit.point, rng.next_2d()) {
+            let d = s.point - hit.point;
+            let dist = d.length();
+            if dist > 0.0 {
+                let d = d / dist;
+                let o = offset_origin(hit.point, hit.ng, d);
+                // As Scene::occluded shortens it, so the light's own surface never occludes.
+                let tmax = dist * (1.0 - 1e-4) - render_core::scene::ray_epsilon(s.point);
+                shadow.push(Segment { o, d, tmax });
+            }
+        }
+        let n = if hit.ng.dot(-dir) >= 0.0 {
+            hit.ng
+        } else {
+            -hit.ng
+        };
+        let d = Frame::from_normal(n).to_world(cosine_hemisphere(rng.next_2d()));
+        bsdf.push(Segment {
+            o: offset_origin(hit.point, hit.ng, d),
+            d,
+            tmax: f32::INFINITY,
+        });
+    }
+    (scene, shadow, bsdf)
+}
+
+fn bench_incoherent(c: &mut Criterion) {
+    let (scene, shadow, bsdf) = emissive_mesh_rays();
+    let mut g = c.benchmark_group("rays_emissive_mesh_incoherent");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(bsdf.len() as u64));
+    g.bench_function("closest_hit", |b| {
+        b.iter(|| {
+            bsdf.iter()
+                .filter(|r| scene.accel.intersect(r.o, r.d, 0.0, r.tmax).is_some())
+                .count()
+        })
+    });
+    g.throughput(Throughput::Elements(shadow.len() as u64));
+    g.bench_function("shadow", |b| {
+        b.iter(|| {
+            shadow
+                .iter()
+                .filter(|r| scene.accel.occluded(r.o, r.d, 0.0, r.tmax))
+                .count()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_rays, bench_incoherent);
 criterion_main!(benches);

@@ -1,0 +1,199 @@
+//! Closest hit and occlusion through the eight-wide tree, generic over the node test so the
+//! AVX2 and SSE2 paths are one loop. Closest hit visits the children a node test finds in
+//! order of entry distance, nearest first (an insertion sort on the stack); occlusion takes
+//! them as they come and stops at the first primitive in the segment.
+use super::Hit;
+use super::collapse::Wide;
+use super::lanes::F4;
+use super::node::{BoxRay, LEAF, NodeTest, leaf_parts, prefetch};
+use super::packet::LaneRay;
+use glam::Vec3;
+use std::mem::MaybeUninit;
+
+/// A stack entry: a child code and the distance at which the ray enters its box.
+#[derive(Clone, Copy)]
+pub struct Entry {
+    code: u32,
+    t: f32,
+}
+
+/// Stack entries kept on the call stack; deeper trees take a heap stack.
+const INLINE_STACK: usize = 128;
+
+/// Stack entries a traversal of a tree `depth` nodes deep may hold at once (a popped node
+/// pushes at most eight children).
+pub fn stack_need(depth: usize) -> usize {
+    8 * depth + 1
+}
+
+/// Runs `f` with an uninitialised stack of at least `need` entries.
+#[inline(always)]
+pub fn with_stack<R>(need: usize, f: impl FnOnce(&mut [MaybeUninit<Entry>]) -> R) -> R {
+    if need <= INLINE_STACK {
+        let mut s = [MaybeUninit::<Entry>::uninit(); INLINE_STACK];
+        f(&mut s)
+    } else {
+        f(&mut vec![MaybeUninit::uninit(); need])
+    }
+}
+
+/// Nearest primitive with t in [tmin, tmax) (an exact tie keeps the one met first).
+#[inline(always)]
+pub fn closest<N: NodeTest>(
+    w: &Wide,
+    o: Vec3,
+    d: Vec3,
+    tmin: f32,
+    mut tmax: f32,
+    stack: &mut [MaybeUninit<Entry>],
+) -> Option<Hit> {
+    let br = BoxRay::new(o, d, tmin);
+    let lr = LaneRay::new(o, d, tmin);
+    let mut best = None;
+    stack[0] = MaybeUninit::new(Entry { code: 0, t: tmin });
+    let mut sp = 1;
+    while sp > 0 {
+        sp -= 1;
+        // SAFETY: entries below `sp` were written.
+        let e = unsafe { stack[sp].assume_init() };
+        if sp > 0 {
+            // The next entry's memory starts loading while this one is tested.
+            // SAFETY: as above.
+            fetch(w, unsafe { stack[sp - 1].assume_init() }.code);
+        }
+        if e.t > tmax {
+            continue;
+        }
+        if e.code & LEAF == 0 {
+            let node = &w.nodes[e.code as usize];
+            let (mut mask, tnear) = N::test(node, &br, tmax);
+            let base = sp;
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let x = Entry {
+                    code: node.child[i],
+                    t: tnear[i],
+                };
+                // Keep entries from `base` up in decreasing distance: the nearest on top.
+                let mut j = sp;
+                // SAFETY: entries below `sp` were written.
+                while j > base && unsafe { stack[j - 1].assume_init() }.t < x.t {
+                    stack[j] = stack[j - 1];
+                    j -= 1;
+                }
+                stack[j] = MaybeUninit::new(x);
+                sp += 1;
+            }
+            continue;
+        }
+        let (first, tris, spheres) = leaf_parts(e.code);
+        let first = first as usize;
+        for p in &w.packets[first..first + tris as usize] {
+            let (mut ok, t, b1, b2) = p.intersect_triangles(&lr, tmax);
+            if ok == 0 {
+                continue;
+            }
+            let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
+            while ok != 0 {
+                let l = ok.trailing_zeros() as usize;
+                ok &= ok - 1;
+                if t[l] < tmax {
+                    tmax = t[l];
+                    best = Some(Hit {
+                        prim: p.ids[l],
+                        t: t[l],
+                        b1: b1[l],
+                        b2: b2[l],
+                    });
+                }
+            }
+        }
+        let s0 = first + tris as usize;
+        for p in &w.packets[s0..s0 + spheres as usize] {
+            let (mut ok, t) = p.intersect_spheres(&lr, tmax);
+            let t = t.to_array();
+            while ok != 0 {
+                let l = ok.trailing_zeros() as usize;
+                ok &= ok - 1;
+                if t[l] < tmax {
+                    tmax = t[l];
+                    best = Some(Hit {
+                        prim: p.ids[l],
+                        t: t[l],
+                        b1: 0.0,
+                        b2: 0.0,
+                    });
+                }
+            }
+        }
+    }
+    best
+}
+
+/// True when a primitive has t in [tmin, tmax).
+#[inline(always)]
+pub fn occluded<N: NodeTest>(
+    w: &Wide,
+    o: Vec3,
+    d: Vec3,
+    tmin: f32,
+    tmax: f32,
+    stack: &mut [MaybeUninit<Entry>],
+) -> bool {
+    let br = BoxRay::new(o, d, tmin);
+    let lr = LaneRay::new(o, d, tmin);
+    let below = F4::splat(tmax);
+    stack[0] = MaybeUninit::new(Entry { code: 0, t: tmin });
+    let mut sp = 1;
+    while sp > 0 {
+        sp -= 1;
+        // SAFETY: entries below `sp` were written.
+        let e = unsafe { stack[sp].assume_init() };
+        if sp > 0 {
+            // The next entry's memory starts loading while this one is tested.
+            // SAFETY: as above.
+            fetch(w, unsafe { stack[sp - 1].assume_init() }.code);
+        }
+        if e.code & LEAF == 0 {
+            let node = &w.nodes[e.code as usize];
+            let (mut mask, _) = N::test(node, &br, tmax);
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack[sp] = MaybeUninit::new(Entry {
+                    code: node.child[i],
+                    t: 0.0,
+                });
+                sp += 1;
+            }
+            continue;
+        }
+        let (first, tris, spheres) = leaf_parts(e.code);
+        let first = first as usize;
+        for p in &w.packets[first..first + tris as usize] {
+            let (ok, t, _, _) = p.intersect_triangles(&lr, tmax);
+            if ok & t.lt(below) != 0 {
+                return true;
+            }
+        }
+        let s0 = first + tris as usize;
+        for p in &w.packets[s0..s0 + spheres as usize] {
+            let (ok, t) = p.intersect_spheres(&lr, tmax);
+            if ok & t.lt(below) != 0 {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Prefetches what `code` names: a node, or a leaf's first packet.
+#[inline(always)]
+fn fetch(w: &Wide, code: u32) {
+    if code & LEAF == 0 {
+        prefetch(&w.nodes[code as usize]);
+    } else {
+        prefetch(&w.packets[leaf_parts(code).0 as usize]);
+    }
+}
