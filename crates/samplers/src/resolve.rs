@@ -96,6 +96,11 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
     Ok(match name {
         "uniform" | "power" | "power+bsdf" | "bsdf" => json!({}),
         "tree" | "tree+bsdf" => json!({ "tree": "single", "power_units": units(opts) }),
+        "sg-tree" | "sg-tree+bsdf" => json!({
+            "tree": "single, spherical-Gaussian importance",
+            "power_units": units(opts),
+            "floor": crate::sg::importance::FLOOR,
+        }),
         "tree-split" | "tree-split+bsdf" => json!({
             "tree": "split",
             "power_units": units(opts),
@@ -134,6 +139,17 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn every_listed_strategy_resolves() {
+        for s in crate::strategies() {
+            assert!(
+                resolved_parameters(s.name, &StrategyOptions::default()).is_ok(),
+                "{}",
+                s.name
+            );
+        }
+    }
+
     use super::*;
 
     #[test]
