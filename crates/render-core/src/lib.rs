@@ -1,7 +1,8 @@
 //! `render-core`: what every strategy and tool of the manylights renderer stands on.
 //!
 //! It owns the scene (geometry, materials, lights, cameras), ray casting through an obvhs
-//! CWBVH, the BSDF of a hit, the per-sample random numbers, the render loop and image output.
+//! CWBVH, the BSDF of a hit, the render loop and image output; the per-sample random numbers, samplers
+//! and pixel filters come from `pixel-samples` (re-exported as `rng`, `sampler`, `filter`).
 //! Light-sampling strategies live in the `samplers` crate and plug in through
 //! [`estimator::DirectLighting`]; scene files and the built-in scenes are read by the
 //! `scene-formats` crate, which builds scenes through [`scene::SceneBuilder`].
@@ -15,23 +16,20 @@ pub mod camera;
 pub mod colour;
 pub mod error;
 pub mod estimator;
-pub mod filter;
 pub mod frame;
-mod hash;
 pub mod light;
 pub mod material;
 pub mod metrics;
 pub mod output;
 pub mod render;
-pub mod rng;
-pub mod sampler;
 pub mod sampling;
 pub mod scene;
 pub mod scene_hash;
 pub mod scene_hints;
 pub mod stats;
 pub mod texture;
-pub mod zsobol;
+
+pub use pixel_samples::{filter, rng, sampler, zsobol};
 
 pub use error::SceneError;
 pub use glam::{Vec2, Vec3};
