@@ -37,7 +37,7 @@ pub fn hemisphere_fraction(z: f32, sharpness: f32) -> f32 {
 }
 
 /// ∫ vMF(ω) max(ω·n, 0) dω for a lobe of sharpness λ at z = μ·n, as E[max(x, 0)] =
-/// (E[x] + E|x|)/2 for the cosine x = ω·n under the lobe: E[x] = z·A(λ) exactly
+/// (E(x) + E|x|)/2 for the cosine x = ω·n under the lobe: E(x) = z·A(λ) exactly
 /// (A = coth λ − 1/λ, the mean resultant length), and E|x| the folded-normal mean of a Gaussian
 /// of x's exact mean and variance s² = z²(1 − 2A/λ − A²) + (1 − z²)A/λ, rescaled by
 /// 1 + z²(r − 1) where r makes it exact at z = ±1 (closed forms there). It is exact at z = ±1,
