@@ -292,6 +292,10 @@ fn add_part(b: &mut SceneBuilder, dir: &Path, part: &GltfPart) -> Result<(), Sce
     Ok(())
 }
 
+/// The most lights one layout places: four times the largest built-in grid (10⁶), and few
+/// enough to build in seconds, so a mistyped count is an error, not an hour-long load.
+const MAX_LAYOUT_LIGHTS: usize = 1 << 22;
+
 fn add_lights(b: &mut SceneBuilder, l: &LightLayout) -> Result<(), SceneError> {
     let err = |m: String| SceneError::BadLight {
         what: "layout".into(),
@@ -301,6 +305,12 @@ fn add_lights(b: &mut SceneBuilder, l: &LightLayout) -> Result<(), SceneError> {
         return Err(err(format!(
             "count {}, size {}, power {} must be positive",
             l.count, l.size, l.power
+        )));
+    }
+    if l.count > MAX_LAYOUT_LIGHTS {
+        return Err(err(format!(
+            "count {} is more than the {MAX_LAYOUT_LIGHTS} lights a layout may place",
+            l.count
         )));
     }
     let mut rng = Pcg32::seed_from_u64(l.seed);
@@ -427,5 +437,12 @@ mod tests {
         );
         let e = load_composition(&p).err().expect("must fail").to_string();
         assert!(e.contains("lights[0]"), "{e}");
+        // a count beyond any machine is refused at once (scene-fuzz found it loading for minutes)
+        let p = write(
+            "huge.toml",
+            "[[lights]]\nlayout = \"random\"\nshape = \"quad\"\ncount = 9223372036854775807\ncenter = [0.0,0.0,0.0]\nextent = [1.0,0.0,1.0]\nsize = 0.1\npower = 1.0\n",
+        );
+        let e = load_composition(&p).err().expect("must fail").to_string();
+        assert!(e.contains("more than the 4194304 lights"), "{e}");
     }
 }
