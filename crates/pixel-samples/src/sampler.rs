@@ -122,19 +122,11 @@ pub(crate) struct SamplePosition {
     pub z: crate::zsobol::ZOrder,
 }
 
-/// The second Sobol dimension (primitive polynomial x + 1, direction numbers all 1), as a
-/// 32-bit fraction.
+/// The second Sobol dimension at a 32-bit index, as a 32-bit fraction (the 64-bit
+/// generator's top bits: the direction numbers only shift right).
 #[inline]
-fn sobol_second(mut index: u32) -> u32 {
-    let (mut v, mut r) = (1u32 << 31, 0u32);
-    while index != 0 {
-        if index & 1 != 0 {
-            r ^= v;
-        }
-        index >>= 1;
-        v ^= v >> 1;
-    }
-    r
+fn sobol_second(index: u32) -> u32 {
+    crate::zsobol::sobol_second_64(index as u64)
 }
 
 /// The hash of one dimension pair of one pixel, from which its shuffle and scrambles come.

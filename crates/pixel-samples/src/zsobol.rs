@@ -112,7 +112,8 @@ fn shuffle_digits(z: &ZOrder, pair: u64) -> u64 {
 }
 
 /// The second Sobol dimension at a 64-bit index, as a 32-bit fraction.
-fn sobol_second_64(mut index: u64) -> u32 {
+#[inline]
+pub(crate) fn sobol_second_64(mut index: u64) -> u32 {
     let (mut v, mut r) = (1u64 << 63, 0u64);
     while index != 0 {
         if index & 1 != 0 {
