@@ -6,6 +6,7 @@ use render_core::filter::PixelFilter;
 use render_core::output::{write_exr, write_json, write_mask_png, write_png};
 use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
+use render_core::splat::Reconstruction;
 use samplers::StrategyOptions;
 use samplers::brdf_oriented::BrdfIntegral;
 use std::path::{Path, PathBuf};
@@ -27,6 +28,11 @@ pub struct RenderArgs {
     /// The scene file's own `PixelFilter` is used when this is not given.
     #[arg(long, value_parser = PixelFilter::parse)]
     pub filter: Option<PixelFilter>,
+    /// How the filter makes pixels of samples: `sampled` (filter importance sampling, each
+    /// sample in its own pixel; the default) or `splat` (pbrt-v3's weighted splatting into every
+    /// pixel within the radius, which `--reproduce` implies).
+    #[arg(long, value_parser = reconstruction_parser())]
+    pub reconstruction: Option<Reconstruction>,
     #[arg(long)]
     pub width: Option<u32>,
     #[arg(long)]
@@ -182,6 +188,26 @@ fn choose_sampler(
     }
 }
 
+/// The reconstruction, and what chose it: the flag, `--reproduce` (the authors' pbrt-v3 film
+/// splats) or the default.
+fn choose_reconstruction(
+    flag: Option<Reconstruction>,
+    reproduce: bool,
+) -> (Reconstruction, &'static str) {
+    match flag {
+        Some(r) => (r, "--reconstruction"),
+        None if reproduce => (Reconstruction::Splat, "--reproduce"),
+        None => (Reconstruction::Sampled, "default"),
+    }
+}
+
+/// `--reconstruction`: the names of [`Reconstruction`], listed in `--help`.
+fn reconstruction_parser() -> impl clap::builder::TypedValueParser<Value = Reconstruction> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(Reconstruction::ALL.map(Reconstruction::name))
+        .map(|s| Reconstruction::parse(&s).expect("a listed name"))
+}
+
 /// `--sampler`: the names of [`Sampler`], listed in `--help`.
 fn sampler_parser() -> impl clap::builder::TypedValueParser<Value = Sampler> {
     use clap::builder::{PossibleValuesParser, TypedValueParser};
@@ -293,6 +319,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         (None, Some(f)) => (f.clone(), "scene file"),
         (None, None) => (PixelFilter::default(), "default"),
     };
+    let (reconstruction, reconstruction_from) =
+        choose_reconstruction(args.reconstruction, opts.reproduce);
     let strategy = samplers::create(&args.strategy.strategy, &scene, &opts)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
@@ -328,6 +356,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         camera: camera.clone(),
         sampler,
         filter: filter.clone(),
+        reconstruction,
     };
     let bar = if args.quiet {
         ProgressBar::hidden()
@@ -412,6 +441,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             "name": filter.name(),
             "parameters": filter.parameters().into_iter().collect::<std::collections::BTreeMap<_, _>>(),
             "from": filter_from,
+            "reconstruction": reconstruction.name(),
+            "reconstruction_from": reconstruction_from,
         },
         "width": width,
         "height": height,

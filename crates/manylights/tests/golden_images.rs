@@ -54,6 +54,7 @@ fn render_case(scene: &Scene, strategy: &str, opts: &StrategyOptions) -> u64 {
         camera: scene.camera(None).unwrap(),
         sampler: Default::default(),
         filter: Default::default(),
+        reconstruction: Default::default(),
     };
     hash_render(&render(scene, s.as_ref(), &settings, &|_, _| {}).unwrap())
 }

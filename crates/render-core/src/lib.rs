@@ -26,6 +26,7 @@ pub mod sampling;
 pub mod scene;
 pub mod scene_hash;
 pub mod scene_hints;
+pub mod splat;
 pub mod stats;
 pub mod texture;
 

@@ -15,6 +15,7 @@ use crate::filter::PixelFilter;
 use crate::rng::SampleStream;
 use crate::sampler::Sampler;
 use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
+use crate::splat::{PassSample, Reconstruction, SampleGrid, SplatFilm};
 use crate::stats::Counters;
 use glam::{Vec2, Vec3};
 use host::process_cpu_seconds;
@@ -43,6 +44,9 @@ pub struct RenderSettings {
     pub sampler: Sampler,
     /// How camera samples are spread over and weighted within their pixel.
     pub filter: PixelFilter,
+    /// How the filter turns samples into pixels: filter importance sampling (each sample in its
+    /// own pixel) or pbrt-v3's weighted splatting (`crate::splat`).
+    pub reconstruction: Reconstruction,
 }
 
 /// A render-time limit, checked before each work unit.
@@ -105,8 +109,9 @@ pub struct RenderResult {
     pub height: u32,
     /// Full passes: every pixel has at least this many samples.
     pub spp: u32,
-    /// Pixels (the first ones in row-major order) with one sample more than `spp`, when a time
-    /// budget stopped the render inside a pass; 0 otherwise.
+    /// Sample pixels (the first ones in row-major order) with one sample more than `spp`, when a
+    /// time budget stopped the render inside a pass; 0 otherwise. Under splatting these are
+    /// pixels of the sample grid, which has a border around the image.
     pub partial_pixels: usize,
     /// Mean radiance per pixel, row-major from the top.
     pub pixels: Vec<Vec3>,
@@ -123,6 +128,8 @@ pub struct RenderResult {
     pub passes: u32,
     /// Worker threads the passes ran on.
     pub threads: usize,
+    /// Pixels without any sample (a budget spent inside the first pass).
+    unsampled: usize,
 }
 
 impl RenderResult {
@@ -138,11 +145,7 @@ impl RenderResult {
 
     /// Pixels that got no sample at all (a time budget spent inside the first pass): black.
     pub fn unsampled_pixels(&self) -> usize {
-        if self.spp > 0 {
-            0
-        } else {
-            self.pixels.len() - self.partial_pixels
-        }
+        self.unsampled
     }
 }
 
@@ -190,15 +193,24 @@ struct PassJob<'a> {
     settings: &'a RenderSettings,
     aspect: f32,
     n_aux: usize,
+    grid: SampleGrid,
 }
 
 impl PassJob<'_> {
-    /// Sample `sample_index` of the pixels of work unit `u`, accumulated into `unit`.
-    fn render_unit(&self, u: usize, sample_index: u64, unit: &mut [PixelAccum], c: &mut Counters) {
-        let (w, h) = (self.settings.width as usize, self.settings.height as usize);
+    /// Sample `sample_index` of the pixels of work unit `u`, accumulated into `unit` and, when
+    /// splatting, kept in `splats` for the pass's gather.
+    fn render_unit(
+        &self,
+        u: usize,
+        sample_index: u64,
+        (unit, splats): (&mut [PixelAccum], &mut [PassSample]),
+        c: &mut Counters,
+    ) {
+        let (w, h) = (self.settings.width as f32, self.settings.height as f32);
+        let grid = self.grid;
         for (i, px) in unit.iter_mut().enumerate() {
             let index = u * UNIT_PIXELS + i;
-            let (x, y) = (index % w, index / w);
+            let (x, y) = grid.image_xy(index);
             let mut rng = SampleStream::with_sampler(
                 self.settings.sampler,
                 self.settings.seed,
@@ -206,12 +218,17 @@ impl PassJob<'_> {
                 sample_index,
             )
             .with_pixel_samples(self.settings.spp.unwrap_or(0))
-            .in_image((x as u32, y as u32), (w as u32, h as u32));
-            let (offset, weight) = self.settings.filter.sample(rng.next_2d());
-            let film = Vec2::new(
-                (x as f32 + offset.x) / w as f32,
-                (y as f32 + offset.y) / h as f32,
+            .in_image(
+                ((index % grid.width) as u32, (index / grid.width) as u32),
+                (grid.width as u32, grid.height as u32),
             );
+            let (offset, weight) = match self.settings.reconstruction {
+                Reconstruction::Sampled => self.settings.filter.sample(rng.next_2d()),
+                // pbrt-v3: uniform over the pixel; the filter weighs the sample at the gather.
+                Reconstruction::Splat => (rng.next_2d(), 1.0),
+            };
+            let on_film = Vec2::new(x as f32 + offset.x, y as f32 + offset.y);
+            let film = on_film / Vec2::new(w, h);
             let mut ctx = SampleContext {
                 counters: c,
                 aux: [0.0; MAX_AUX],
@@ -238,6 +255,13 @@ impl PassJob<'_> {
             px.light_hits += sees_light as u32;
             for (acc, v) in px.aux.iter_mut().zip(aux).take(self.n_aux) {
                 *acc += v as f64;
+            }
+            if let Some(s) = splats.get_mut(i) {
+                *s = PassSample {
+                    radiance: l,
+                    film: on_film,
+                    sees_light,
+                };
             }
         }
     }
@@ -343,7 +367,11 @@ pub fn render(
     let (w, h) = (settings.width as usize, settings.height as usize);
     let aspect = w as f32 / h as f32;
     let n_aux = strategy.aux_channels().len().min(MAX_AUX);
-    let mut accum = vec![PixelAccum::default(); w * h];
+    let grid = SampleGrid::new(w, h, settings.reconstruction, &settings.filter);
+    let splatting = settings.reconstruction == Reconstruction::Splat;
+    let mut accum = vec![PixelAccum::default(); grid.len()];
+    let mut splats = vec![PassSample::default(); if splatting { grid.len() } else { 0 }];
+    let mut film = splatting.then(|| SplatFilm::new(w, h, settings.filter.clone()));
     let threads = pool.current_num_threads();
     let start = Instant::now();
     let cpu_start = process_cpu_seconds();
@@ -360,6 +388,7 @@ pub fn render(
         settings,
         aspect,
         n_aux,
+        grid,
     };
     let mut counters = Counters::default();
     let mut spp_done = 0u32;
@@ -378,8 +407,11 @@ pub fn render(
         let sample_index = spp_done as u64;
         // Units are handed out in order, and every unit claimed is finished: the units done
         // in this pass are always a prefix of the image.
-        let units: Vec<Mutex<&mut [PixelAccum]>> =
-            accum.chunks_mut(UNIT_PIXELS).map(Mutex::new).collect();
+        let mut splat_chunks = splats.chunks_mut(UNIT_PIXELS);
+        let units: Vec<Mutex<(&mut [PixelAccum], &mut [PassSample])>> = accum
+            .chunks_mut(UNIT_PIXELS)
+            .map(|a| Mutex::new((a, splat_chunks.next().unwrap_or_default())))
+            .collect();
         let next_unit = AtomicUsize::new(0);
         let pass_counters: Vec<Counters> = pool.broadcast(|_| {
             let mut c = Counters::default();
@@ -396,7 +428,8 @@ pub fn render(
                     break;
                 };
                 let mut unit = unit.lock().unwrap_or_else(|e| e.into_inner());
-                job.render_unit(u, sample_index, &mut unit, &mut c);
+                let (a, s) = &mut *unit;
+                job.render_unit(u, sample_index, (a, s), &mut c);
             }
             c
         });
@@ -407,14 +440,20 @@ pub fn render(
         if done == 0 && spp_done == 0 {
             // A budget spent before the first unit: take that one anyway, so every render has a sample.
             let mut unit = units[0].lock().unwrap_or_else(|e| e.into_inner());
-            job.render_unit(0, sample_index, &mut unit, &mut counters);
+            let (a, s) = &mut *unit;
+            job.render_unit(0, sample_index, (a, s), &mut counters);
             done = 1;
         }
+        let n_units = units.len();
+        drop(units);
         if done == 0 {
             break;
         }
+        if let Some(film) = &mut film {
+            film.gather_pass(grid, &splats, (done * UNIT_PIXELS).min(grid.len()));
+        }
         passes += 1;
-        if done < units.len() {
+        if done < n_units {
             partial_pixels = done * UNIT_PIXELS;
             progress(passes, spp_done);
             break;
@@ -424,6 +463,68 @@ pub fn render(
         progress(passes, spp_done);
     }
     let samples = |i: usize| (spp_done + (i < partial_pixels) as u32) as f64;
+    let image = match &film {
+        None => own_samples_image(&accum, samples),
+        Some(film) => FinishedImage {
+            pixels: film.pixels(),
+            variance_of_mean: film.variance_of_mean(),
+            light_fraction: film.light_fraction(),
+            unsampled: film.empty_pixels(),
+        },
+    };
+    // The image's pixels in the sample grid (the same pixels unless a splat border surrounds it).
+    let cropped: Vec<usize> = (0..w * h)
+        .map(|i| (i / w + grid.border) * grid.width + i % w + grid.border)
+        .collect();
+    let aux = strategy
+        .aux_channels()
+        .iter()
+        .take(n_aux)
+        .enumerate()
+        .map(|(k, name)| {
+            let aux_mean = |&g: &usize| {
+                let n = samples(g);
+                if n > 0.0 { accum[g].aux[k] / n } else { 0.0 }
+            };
+            (
+                name.to_string(),
+                cropped.iter().map(|g| aux_mean(g) as f32).collect(),
+            )
+        })
+        .collect();
+    let wall_seconds = start.elapsed().as_secs_f64();
+    let cpu_seconds = match (cpu_start, process_cpu_seconds()) {
+        (Some(a), Some(b)) => Some(b - a),
+        _ => None,
+    };
+    Ok(RenderResult {
+        width: settings.width,
+        height: settings.height,
+        spp: spp_done,
+        partial_pixels,
+        pixels: image.pixels,
+        variance_of_mean: image.variance_of_mean,
+        light_fraction: image.light_fraction,
+        aux,
+        counters,
+        wall_seconds,
+        cpu_seconds,
+        passes,
+        threads,
+        unsampled: image.unsampled,
+    })
+}
+
+/// The finished image before its diagnostics channels.
+struct FinishedImage {
+    pixels: Vec<Vec3>,
+    variance_of_mean: Vec<Vec3>,
+    light_fraction: Vec<f32>,
+    unsampled: usize,
+}
+
+/// Each pixel the mean of its own samples (filter importance sampling), `samples(i)` of them.
+fn own_samples_image(accum: &[PixelAccum], samples: impl Fn(usize) -> f64) -> FinishedImage {
     let mean = |sum: f64, n: f64| if n > 0.0 { sum / n } else { 0.0 };
     let pixels = accum
         .iter()
@@ -457,42 +558,12 @@ pub fn render(
         .enumerate()
         .map(|(i, p)| mean(p.light_hits as f64, samples(i)) as f32)
         .collect();
-    let aux = strategy
-        .aux_channels()
-        .iter()
-        .take(n_aux)
-        .enumerate()
-        .map(|(k, name)| {
-            (
-                name.to_string(),
-                accum
-                    .iter()
-                    .enumerate()
-                    .map(|(i, p)| mean(p.aux[k], samples(i)) as f32)
-                    .collect(),
-            )
-        })
-        .collect();
-    let wall_seconds = start.elapsed().as_secs_f64();
-    let cpu_seconds = match (cpu_start, process_cpu_seconds()) {
-        (Some(a), Some(b)) => Some(b - a),
-        _ => None,
-    };
-    Ok(RenderResult {
-        width: settings.width,
-        height: settings.height,
-        spp: spp_done,
-        partial_pixels,
+    FinishedImage {
         pixels,
         variance_of_mean,
         light_fraction,
-        aux,
-        counters,
-        wall_seconds,
-        cpu_seconds,
-        passes,
-        threads,
-    })
+        unsampled: (0..accum.len()).filter(|&i| samples(i) == 0.0).count(),
+    }
 }
 
 #[cfg(test)]
@@ -591,6 +662,7 @@ mod tests {
             camera: scene.camera(None).unwrap(),
             sampler,
             filter: Default::default(),
+            reconstruction: Default::default(),
         };
         render(scene, &OneLight, &settings, &|_, _| {}).unwrap()
     }

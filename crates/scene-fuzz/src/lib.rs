@@ -321,6 +321,7 @@ fn load_and_render(path: &Path, case: u64) -> Result<Outcome, String> {
         camera,
         sampler: Default::default(),
         filter: Default::default(),
+        reconstruction: Default::default(),
     };
     match render_core::render::render(&scene, strategy.as_ref(), &settings, &|_, _| {}) {
         Ok(r) => {

@@ -231,6 +231,31 @@ pub fn render_sampled(
     size: Option<(u32, u32)>,
     sampler: render_core::sampler::Sampler,
 ) -> RenderResult {
+    render_film(
+        scene,
+        name,
+        opts,
+        spp,
+        (threads, seed),
+        size,
+        (sampler, Default::default(), Default::default()),
+    )
+}
+
+/// [`render_sampled`] with a pixel filter and a reconstruction too.
+pub fn render_film(
+    scene: &Scene,
+    name: &str,
+    opts: &samplers::StrategyOptions,
+    spp: u32,
+    (threads, seed): (usize, u64),
+    size: Option<(u32, u32)>,
+    (sampler, filter, reconstruction): (
+        render_core::sampler::Sampler,
+        render_core::filter::PixelFilter,
+        render_core::splat::Reconstruction,
+    ),
+) -> RenderResult {
     let strategy = samplers::create(name, scene, opts).unwrap();
     let mut camera = scene.camera(None).unwrap();
     if let Some((w, h)) = size {
@@ -246,7 +271,8 @@ pub fn render_sampled(
         threads: Some(threads),
         camera,
         sampler,
-        filter: Default::default(),
+        filter,
+        reconstruction,
     };
     render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
 }

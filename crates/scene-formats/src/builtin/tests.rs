@@ -409,6 +409,7 @@ fn every_builtin_renders_a_lit_image() {
             camera,
             sampler: Default::default(),
             filter: Default::default(),
+            reconstruction: Default::default(),
         };
         let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
         // Leave out pixels that see a light directly: the rest is reflected light.
