@@ -184,7 +184,9 @@ fn choose_sampler(
         (Some(s), _) => (s, "--sampler"),
         (None, Some(s)) => (s, "scene file"),
         (None, None) if reproduce => (Sampler::LowDiscrepancy, "--reproduce"),
-        (None, None) => (Sampler::Independent, "default"),
+        // The samplers experiment (results/samplers): at equal time Sobol beat independent numbers
+        // by 1.39× (MIS adaptive) and 1.12× (E&K) in geometric mean, lowdiscrepancy 1.35× / 1.13×.
+        (None, None) => (Sampler::Sobol, "default"),
     }
 }
 
