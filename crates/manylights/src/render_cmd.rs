@@ -8,7 +8,7 @@ use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
 use render_core::splat::Reconstruction;
 use samplers::StrategyOptions;
-use samplers::brdf_oriented::BrdfIntegral;
+use samplers::brdf_oriented::{BoImportance, BrdfIntegral};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -131,6 +131,12 @@ pub struct MethodArgs {
     #[arg(long, default_value_t = StrategyOptions::default().brdf_integral,
           value_parser = brdf_integral_parser())]
     pub brdf_integral: BrdfIntegral,
+    /// Node importance of BRDF-oriented sampling's cluster choice and descent: `cap` (I_BO from
+    /// the cap integrals, the paper) or `sg` (the spherical-Gaussian importance of sg-tree);
+    /// the BO cut and heuristic 1's UB use the cap integrals either way.
+    #[arg(long, default_value_t = StrategyOptions::default().bo_importance,
+          value_parser = bo_importance_parser())]
+    pub bo_importance: BoImportance,
     /// The authors' code's behaviour: nearest SPTD lookup, Oat–Sander cap ∩ cap, glossy-only
     /// importance, one rescaled random number per descent, in-sample (biased) allocation.
     #[arg(long)]
@@ -171,6 +177,12 @@ pub enum BudgetClockArg {
 fn brdf_integral_parser() -> impl clap::builder::TypedValueParser<Value = BrdfIntegral> {
     use clap::builder::{PossibleValuesParser, TypedValueParser};
     PossibleValuesParser::new(BrdfIntegral::ALL.map(BrdfIntegral::name)).try_map(|s| s.parse())
+}
+
+/// `--bo-importance`: the names of [`BoImportance`], listed in `--help`.
+fn bo_importance_parser() -> impl clap::builder::TypedValueParser<Value = BoImportance> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(BoImportance::ALL.map(BoImportance::name)).try_map(|s| s.parse())
 }
 
 /// The sampler a render uses, and why: `--sampler`, else the scene file's, else pbrt-v3's
@@ -226,6 +238,7 @@ impl MethodArgs {
             n_max: self.n_max,
             lambda: self.lambda,
             brdf_integral: self.brdf_integral,
+            bo_importance: self.bo_importance,
             reproduce: self.reproduce,
             pivot_sphere: self.pivot_sphere,
             adaptive_total: !self.no_adaptive_total,

@@ -66,9 +66,22 @@ fn bench_strategies(c: &mut Criterion) {
             .warm_up_time(Duration::from_millis(300))
             .measurement_time(Duration::from_secs(1))
             .throughput(Throughput::Elements(points.len() as u64));
-        for info in samplers::strategies() {
-            let strategy = samplers::create(info.name, &scene, &options).unwrap();
-            g.bench_function(info.name, |b| {
+        // Every strategy with the defaults, then the method's variants (issue 24: BO weighed by
+        // the SG importance) under a name of their own.
+        let sg = StrategyOptions {
+            bo_importance: samplers::brdf_oriented::BoImportance::Sg,
+            ..options.clone()
+        };
+        let variants = samplers::strategies()
+            .into_iter()
+            .map(|info| (info.name.to_string(), info.name, &options))
+            .chain(
+                ["brdf-oriented", "mis3-equal", "mis3-adaptive"]
+                    .map(|n| (format!("{n} --bo-importance sg"), n, &sg)),
+            );
+        for (id, name, opts) in variants {
+            let strategy = samplers::create(name, &scene, opts).unwrap();
+            g.bench_function(id, |b| {
                 let mut counters = Counters::default();
                 let mut memory = vec![[0.0f32; PIXEL_MEMORY]; points.len()];
                 let mut sample = 0u64;

@@ -61,6 +61,10 @@ pub struct StrategyOptions {
     pub lambda: f32,
     /// Cap-integral approximation behind BO.
     pub brdf_integral: brdf_oriented::BrdfIntegral,
+    /// The node importance of BO's cluster choice and descent in the `mis3` strategies: the
+    /// cap integrals' I_BO (default) or the SG importance (issue 24); the BO cut and UB keep
+    /// the cap integrals either way.
+    pub bo_importance: brdf_oriented::BoImportance,
     /// Every behaviour of the authors' code, for every tree strategy: their power units
     /// (`LeWithArea`), their E&K σ (scene units, `V[e]` = 0 from three lights on), no cap on
     /// either cut; for the method also the nearest SPTD lookup, Oat–Sander cap ∩ cap,
@@ -141,6 +145,7 @@ impl Default for StrategyOptions {
             n_max: 50,
             lambda: 10.0,
             brdf_integral: brdf_oriented::BrdfIntegral::Sptd,
+            bo_importance: brdf_oriented::BoImportance::Cap,
             reproduce: false,
             pivot_sphere: false,
             adaptive_total: true,
@@ -365,14 +370,18 @@ fn mis3(
     )
     .map_err(StrategyError::BadOption)?;
     let config = resolve::bo_config(opts);
+    let sg_nodes = match (opts.bo_importance, &ls.tree) {
+        (brdf_oriented::BoImportance::Sg, Some(tree)) => Some(
+            light_tree::SgNodes::build(tree, &sg::sg_emitters(scene))
+                .map_err(|e| StrategyError::BadOption(format!("SG lights: {e}")))?,
+        ),
+        _ => None,
+    };
     Ok(match opts.brdf_integral {
-        BrdfIntegral::Sptd => Box::new(Mis3::new(
-            name.into(),
-            mode,
-            ls,
-            resolve::sptd(opts),
-            config,
-        )),
+        BrdfIntegral::Sptd => Box::new(Mis3 {
+            sg_nodes,
+            ..Mis3::new(name.into(), mode, ls, resolve::sptd(opts), config)
+        }),
         BrdfIntegral::Ltc => {
             use brdf_integrals::CapIntegral;
             let integral = resolve::ltc(opts);
@@ -383,7 +392,10 @@ fn mis3(
                     "--brdf-integral ltc: the LTC table integrates to 0".into(),
                 ));
             }
-            Box::new(Mis3::new(name.into(), mode, ls, integral, config))
+            Box::new(Mis3 {
+                sg_nodes,
+                ..Mis3::new(name.into(), mode, ls, integral, config)
+            })
         }
     })
 }

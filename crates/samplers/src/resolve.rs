@@ -20,6 +20,7 @@ pub fn bo_config(opts: &StrategyOptions) -> BoConfig {
         max_cut: opts.split_params().max_size,
         max_cut_bo: opts.split_params().max_size,
         brdf_integral: opts.brdf_integral,
+        bo_importance: opts.bo_importance,
         reproduce: opts.reproduce,
         pivot_sphere: opts.pivot_sphere,
         adaptive_total: opts.adaptive_total,

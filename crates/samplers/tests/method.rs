@@ -10,8 +10,10 @@ use render_core::render::RenderResult;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
+use samplers::brdf_oriented::BoImportance;
 use samplers::brdf_oriented::importance::BoRecord;
 use samplers::brdf_oriented::pivot_sphere::PivotSphere;
+use samplers::brdf_oriented::sg_importance::SgImportance;
 use samplers::brdf_oriented::technique::BoState;
 use samplers::convergence::compare;
 use samplers::selection::LightSelection;
@@ -74,8 +76,15 @@ fn check_against_reference(scene: &Scene, size: Option<(u32, u32)>, ref_spp: u32
         stratified: false,
         ..d.clone()
     };
+    let sg = StrategyOptions {
+        bo_importance: BoImportance::Sg,
+        ..d.clone()
+    };
     for (name, opts, label) in [
         ("mis3-adaptive", &ltc, "mis3-adaptive --brdf-integral ltc"),
+        ("mis3-adaptive", &sg, "mis3-adaptive --bo-importance sg"),
+        // The SG importance is zero only where the E&K bound is: BO alone is complete.
+        ("brdf-oriented", &sg, "brdf-oriented --bo-importance sg"),
         ("mis3-equal", &d, "mis3-equal"),
         ("mis3-adaptive", &d, "mis3-adaptive"),
         ("mis3-adaptive", &pivot, "mis3-adaptive --pivot-sphere"),
@@ -199,11 +208,11 @@ fn shading_points(scene: &Scene) -> Vec<ShadingPoint> {
     common::shading_points_towards(scene, common::MIXED_CAMERA, &common::MIXED_TARGETS)
 }
 
-fn bo_state(
+fn bo_state<'a>(
     sel: &TreeSelection,
     sp: &ShadingPoint,
     pivot: bool,
-) -> BoState<<Sptd as CapIntegral>::Lobe> {
+) -> BoState<'a, <Sptd as CapIntegral>::Lobe> {
     let sptd = Sptd::default();
     let lobe = sptd.lobe(sp.bsdf.frame.to_local(sp.wo), sp.bsdf.params.alpha);
     let pivot = pivot.then_some(PivotSphere { pivot: lobe.pivot });
@@ -491,4 +500,110 @@ fn mis3_converges_on_the_other_builtins() {
             failures.join("\n")
         );
     }
+}
+
+/// BO under `--bo-importance sg` at the mixed scene's points: the same cut (nodes and cap
+/// integrals, so the same UB) as under I_BO, every cluster's importance the SG importance (zero
+/// exactly where the E&K bound is), the selection probability at sampling equal to the replayed
+/// pmf bit for bit, and the drawn lights distributed as that pmf (chi-square, fresh and
+/// rescaled descents).
+#[test]
+fn bo_under_sg_importance_matches_its_pmf_chi2_and_replay() {
+    let scene = common::mixed_scene(40);
+    let sel = TreeSelection::new(
+        &scene,
+        TreeMode::Split(SplitParams {
+            tau: 0.85,
+            max_size: 64,
+            criterion: SplitCriterion::Authors,
+        }),
+        PowerUnits::Watts,
+    )
+    .unwrap();
+    let tree = sel.tree.as_ref().unwrap();
+    let nodes = light_tree::SgNodes::build(tree, &samplers::sg::sg_emitters(&scene)).unwrap();
+    let sptd = Sptd::default();
+    let n = scene.lights.len();
+    for (k, sp) in shading_points(&scene).iter().enumerate() {
+        let lobe = sptd.lobe(sp.bsdf.frame.to_local(sp.wo), sp.bsdf.params.alpha);
+        let rec = BoRecord::new(sp, lobe, true, false);
+        let sg = SgImportance::new(&nodes, sp);
+        let cap = BoState::new(tree, rec, 0.5, 64, None);
+        let bo = BoState::with_importance(tree, rec, Some(sg), 0.5, 64, None);
+        assert_eq!(
+            bo.cut().cut.nodes,
+            cap.cut().cut.nodes,
+            "point {k}: same cut"
+        );
+        assert_eq!(bo.cut().upper_bound(), cap.cut().upper_bound());
+        for (i, &id) in bo.cut().cut.nodes.iter().enumerate() {
+            let t = bo.cut().terms[i];
+            assert_eq!(t.glossy, cap.cut().terms[i].glossy);
+            assert_eq!(t.importance, sg.importance(tree, id));
+            let ek = tree.node(id).importance(sp.point(), sp.bsdf.ng);
+            assert_eq!(t.importance > 0.0, ek > 0.0, "point {k} node {id}");
+        }
+        for fresh in [true, false] {
+            let mut observed = vec![0.0; n + 1];
+            let samples = 100_000;
+            for i in 0..samples {
+                let mut rng = SampleStream::new(23 + k as u64, 0, i);
+                match bo.select(tree, &mut rng, fresh) {
+                    Some((light, p)) => {
+                        assert_eq!(
+                            p,
+                            bo.selection_pmf(tree, light),
+                            "pmf at sampling vs replay"
+                        );
+                        observed[light] += 1.0;
+                    }
+                    None => observed[n] += 1.0,
+                }
+            }
+            let mut expected: Vec<f64> = (0..n)
+                .map(|l| bo.selection_pmf(tree, l) as f64 * samples as f64)
+                .collect();
+            let total: f64 = expected.iter().sum();
+            assert!(total <= samples as f64 * (1.0 + 1e-5));
+            expected.push((samples as f64 - total).max(0.0));
+            let out = chi2_test(&observed, &expected);
+            assert!(
+                out.p_value > 1e-4,
+                "point {k} fresh {fresh}: p = {} ({})",
+                out.p_value,
+                out.message
+            );
+        }
+    }
+}
+
+/// `mis3-adaptive --bo-importance sg` renders the same image on one thread and on two, and
+/// another image than under I_BO.
+#[test]
+fn sg_importance_image_is_identical_for_any_thread_count() {
+    let scene = common::mixed_scene(10);
+    let sg = StrategyOptions {
+        bo_importance: BoImportance::Sg,
+        ..Default::default()
+    };
+    let a = common::render_opts(&scene, "mis3-adaptive", &sg, 4, 1, 7, None);
+    let b = common::render_opts(&scene, "mis3-adaptive", &sg, 4, 2, 7, None);
+    let bits = |r: &RenderResult| -> Vec<[u32; 3]> {
+        r.pixels
+            .iter()
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect()
+    };
+    assert!(bits(&a) == bits(&b), "1 vs 2 threads");
+    assert_eq!(a.counters, b.counters);
+    let c = common::render_opts(
+        &scene,
+        "mis3-adaptive",
+        &StrategyOptions::default(),
+        4,
+        2,
+        7,
+        None,
+    );
+    assert!(a.pixels != c.pixels, "the option changes the image");
 }

@@ -1,7 +1,10 @@
 //! The BRDF-oriented light cut (method.md §1.3): from the root, split a node when x lies inside
 //! its bounding sphere or when the glossy lobe's integral over the node's cap exceeds δ. Every
 //! cut node keeps its BO importance and its cap integral (the allocation's UB reuses them).
+//! Under `--bo-importance sg` the cut is made the same way and each cut node's importance is
+//! then its SG importance ([`super::sg_importance`]).
 use super::importance::{BoRecord, LobeDensity, NodeTerms};
+use super::sg_importance::SgImportance;
 use brdf_integrals::LobeIntegral;
 use light_tree::{Cut, LightTree, NodeId};
 use std::collections::VecDeque;
@@ -46,6 +49,20 @@ impl BoCut {
         max_size: usize,
         scratch: &mut BoCutScratch,
     ) {
+        self.build_weighted_into(tree, rec, None, delta, max_size, scratch);
+    }
+
+    /// [`BoCut::build_into`] with the cut nodes' importances taken from `sg` when given: the
+    /// split test and the cached cap integrals (UB) stay the method's.
+    pub fn build_weighted_into<L: LobeIntegral + LobeDensity>(
+        &mut self,
+        tree: &LightTree,
+        rec: &BoRecord<L>,
+        sg: Option<&SgImportance>,
+        delta: f32,
+        max_size: usize,
+        scratch: &mut BoCutScratch,
+    ) {
         let BoCutScratch { out, queue } = scratch;
         out.clear();
         queue.clear();
@@ -75,6 +92,12 @@ impl BoCut {
             }
         }
         out.sort_unstable_by_key(|&(id, _)| id);
+        if let Some(sg) = sg {
+            // Only the nodes kept: the split nodes' SG importance would never be read.
+            for (id, t) in out.iter_mut() {
+                t.importance = sg.importance(tree, *id);
+            }
+        }
         self.cut.nodes.clear();
         self.terms.clear();
         self.cdf.clear();

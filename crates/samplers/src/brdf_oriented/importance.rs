@@ -60,7 +60,8 @@ struct PeakBound {
 /// A node's BO terms at a shading point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct NodeTerms {
-    /// I_BO (0 when the node cannot be reached or its cap lies below the horizon).
+    /// I_BO (0 when the node cannot be reached or its cap lies below the horizon); in a cut
+    /// built under `--bo-importance sg`, the node's SG importance instead.
     pub importance: f32,
     /// ∫_{cap∩H} f·cos of the glossy lobe without Ks (the split test and the allocation's UB).
     pub glossy: f32,

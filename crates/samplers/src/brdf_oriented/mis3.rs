@@ -6,6 +6,7 @@ use super::allocation::{
 };
 use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
+use super::sg_importance::SgImportance;
 use super::technique::BoState;
 use super::three_techniques::{PointTechniques, Taken};
 pub use super::three_techniques::{TECHNIQUE_BO, TECHNIQUE_BSDF, TECHNIQUE_LS};
@@ -50,6 +51,8 @@ pub struct Mis3<C: CapIntegral> {
     pub integral: C,
     /// The method's knobs.
     pub config: BoConfig,
+    /// The tree's SG lights, under `--bo-importance sg` (see [`super::sg_importance`]).
+    pub sg_nodes: Option<light_tree::SgNodes>,
     /// Heuristic 1's N_max for the next pass (f32 bits): `config.n_max`, or with
     /// `efficient_total` what [`EfficiencyTally::best_n_max`] chose after the last pass.
     pub n_max_now: AtomicU32,
@@ -83,7 +86,7 @@ impl<C: CapIntegral> Mis3<C>
 where
     C::Lobe: LobePivot + LobeDensity,
 {
-    fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<C::Lobe>> {
+    fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<'_, C::Lobe>> {
         let tree = self.ls.tree.as_ref()?;
         let wo_local = sp.bsdf.frame.to_local(sp.wo);
         let lobe = self.integral.lobe(wo_local, sp.bsdf.params.alpha);
@@ -93,9 +96,11 @@ where
             None
         };
         let rec = BoRecord::new(sp, lobe, !self.config.reproduce, self.config.reproduce);
-        Some(BoState::new(
+        let sg = self.sg_nodes.as_ref().map(|n| SgImportance::new(n, sp));
+        Some(BoState::with_importance(
             tree,
             rec,
+            sg,
             self.config.delta,
             self.config.max_cut_bo,
             pivot,
@@ -119,6 +124,7 @@ impl<C: CapIntegral> Mis3<C> {
             ls,
             integral,
             config,
+            sg_nodes: None,
             n_max_now,
             n_max_log: Mutex::new(NMaxLog::default()),
         }

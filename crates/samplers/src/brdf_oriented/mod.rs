@@ -8,11 +8,14 @@
 //! * [`allocation`]: the two allocation heuristics and the unbiased fixed-count variant.
 //! * [`mis3`]: the strategies `brdf-oriented`, `mis3-equal`, `mis3-adaptive`.
 //! * [`pivot_sphere`]: optional pivot-transformed point sampling on sphere lights.
+//! * [`sg_importance`]: the SG node importance (Tokuyoshi et al. 2024) as BO's cluster and
+//!   descent importance (`--bo-importance sg`).
 pub mod allocation;
 pub mod cut;
 pub mod importance;
 pub mod mis3;
 pub mod pivot_sphere;
+pub mod sg_importance;
 pub mod technique;
 pub mod three_techniques;
 
@@ -60,6 +63,48 @@ impl std::str::FromStr for BrdfIntegral {
     }
 }
 
+/// Which node importance chooses BO's clusters and its descent inside a cluster. The BO cut's
+/// split test and heuristic 1's UB use the cap integrals of [`BrdfIntegral`] under either.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum BoImportance {
+    /// I_BO from the cap integrals of [`BrdfIntegral`] (the paper).
+    #[default]
+    Cap,
+    /// The spherical-Gaussian lighting integral of each node with the BSDF (Tokuyoshi et al.
+    /// 2024, [`crate::sg::importance`]), with its floor that keeps every node the bounds admit.
+    Sg,
+}
+
+impl BoImportance {
+    /// Every choice, in the order `--help` lists them.
+    pub const ALL: [BoImportance; 2] = [BoImportance::Cap, BoImportance::Sg];
+
+    /// The name on the command line and in the render's JSON.
+    pub fn name(self) -> &'static str {
+        match self {
+            BoImportance::Cap => "cap",
+            BoImportance::Sg => "sg",
+        }
+    }
+}
+
+impl std::fmt::Display for BoImportance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for BoImportance {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        BoImportance::ALL
+            .into_iter()
+            .find(|b| b.name() == s)
+            .ok_or_else(|| format!("unknown BO importance `{s}` (known: cap, sg)"))
+    }
+}
+
 /// Knobs of the method (recorded in the render's JSON).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct BoConfig {
@@ -77,6 +122,10 @@ pub struct BoConfig {
     pub max_cut_bo: usize,
     /// Cap-integral approximation behind BO.
     pub brdf_integral: BrdfIntegral,
+    /// The node importance of BO's cluster choice and descent (the cut and UB keep the cap
+    /// integrals).
+    #[serde(default)]
+    pub bo_importance: BoImportance,
     /// The authors' code's behaviour throughout.
     pub reproduce: bool,
     /// Pivot-sphere point sampling on sphere lights.

@@ -1,8 +1,10 @@
 //! BRDF-oriented light sampling (BO) at one shading point: pick a cluster of the BO cut by
 //! I_BO, descend inside it by I_BO, sample a point on the light; and the pdf of any light point.
+//! Under `--bo-importance sg` the cluster choice and the descent use the SG importance instead.
 use super::cut::{BoCut, BoCutScratch};
 use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
+use super::sg_importance::SgImportance;
 use crate::memo::NodeMemo;
 use crate::scratch::Pooled;
 use brdf_integrals::LobeIntegral;
@@ -25,16 +27,19 @@ crate::scratch_pool!(BoScratch, |s| s.memo.get_mut().invalidate());
 
 /// Per-shading-point BO state: the record, the BO cut with its cluster distribution, and the
 /// memoised node importances shared by sampling and pdf evaluation. Its buffers are on loan
-/// from a per-thread pool (no allocation per shading point).
-pub struct BoState<L> {
+/// from a per-thread pool (no allocation per shading point). `'a`: the SG lights it weighs
+/// nodes by under `--bo-importance sg`.
+pub struct BoState<'a, L> {
     /// The shading point's record.
     pub rec: BoRecord<L>,
     scratch: Pooled<BoScratch>,
     /// Pivot-sphere point sampling (method.md §3.1), if enabled.
     pub pivot: Option<PivotSphere>,
+    /// The SG importance that replaces I_BO in the cluster choice and the descent, if chosen.
+    sg: Option<SgImportance<'a>>,
 }
 
-impl<L: LobeIntegral + LobeDensity> BoState<L> {
+impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
     /// Builds the BO cut of the shading point of `rec` (split while the cap integral > `delta`,
     /// at most `max_cut` clusters).
     pub fn new(
@@ -44,13 +49,27 @@ impl<L: LobeIntegral + LobeDensity> BoState<L> {
         max_cut: usize,
         pivot: Option<PivotSphere>,
     ) -> Self {
+        Self::with_importance(tree, rec, None, delta, max_cut, pivot)
+    }
+
+    /// [`BoState::new`] with the clusters and the descent weighed by the SG importance `sg`
+    /// when given (`--bo-importance sg`); the cut and its cap integrals (UB) are the same.
+    pub fn with_importance(
+        tree: &LightTree,
+        rec: BoRecord<L>,
+        sg: Option<SgImportance<'a>>,
+        delta: f32,
+        max_cut: usize,
+        pivot: Option<PivotSphere>,
+    ) -> Self {
         let mut scratch = Pooled::<BoScratch>::take();
         let BoScratch { cut, build, .. } = &mut *scratch;
-        cut.build_into(tree, &rec, delta, max_cut, build);
+        cut.build_weighted_into(tree, &rec, sg.as_ref(), delta, max_cut, build);
         BoState {
             rec,
             scratch,
             pivot,
+            sg,
         }
     }
 
@@ -60,12 +79,15 @@ impl<L: LobeIntegral + LobeDensity> BoState<L> {
         &self.scratch.cut
     }
 
-    /// I_BO of `id` (memoised).
+    /// The descent's importance of `id` (memoised): I_BO, or the SG importance.
     pub fn importance(&self, tree: &LightTree, id: NodeId) -> f32 {
         self.scratch
             .memo
             .borrow_mut()
-            .get_or(id, |id| self.rec.terms(tree.node(id)).importance)
+            .get_or(id, |id| match &self.sg {
+                Some(sg) => sg.importance(tree, id),
+                None => self.rec.terms(tree.node(id)).importance,
+            })
     }
 
     /// Chooses a light: `(light, selection probability)`: a cluster by I_BO, then a descent by

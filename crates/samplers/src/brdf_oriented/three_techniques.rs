@@ -49,7 +49,7 @@ pub struct PointTechniques<'a, L> {
     /// The LS cut of this point.
     pub ls_state: TreeState,
     /// The BO state, at glossy points.
-    pub bo: Option<BoState<L>>,
+    pub bo: Option<BoState<'a, L>>,
     /// BO's descent takes a fresh random number per tree level (off: the authors' rescaled one).
     pub fresh: bool,
 }

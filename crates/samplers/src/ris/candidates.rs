@@ -27,7 +27,7 @@ pub struct CandidateSource<'a, L> {
     n: Vec3,
     /// The tree importances of this shading point, memoised (shared by draws and replays).
     memo: RefCell<Pooled<NodeMemo>>,
-    bo: Option<&'a BoState<L>>,
+    bo: Option<&'a BoState<'a, L>>,
     /// Candidates drawn by LS.
     pub n_ls: u32,
     /// Candidates drawn by BO.
@@ -48,7 +48,7 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
         scene: &'a Scene,
         tree: &'a LightTree,
         sp: &ShadingPoint,
-        bo: Option<&'a BoState<L>>,
+        bo: Option<&'a BoState<'a, L>>,
         m: u32,
     ) -> Self {
         let n_bo = if bo.is_some() { m / 2 } else { 0 };

@@ -73,7 +73,7 @@ where
     C::Lobe: LobePivot + LobeDensity,
 {
     /// The BO state of a point (none on pure diffuse points, as in `mis3`).
-    pub fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<C::Lobe>> {
+    pub fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<'_, C::Lobe>> {
         let tree = self.tree.as_ref()?;
         if sp.bsdf.is_pure_diffuse() {
             return None;
