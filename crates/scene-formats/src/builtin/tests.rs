@@ -410,6 +410,7 @@ fn every_builtin_renders_a_lit_image() {
             sampler: Default::default(),
             filter: Default::default(),
             reconstruction: Default::default(),
+            emission_rays: Default::default(),
         };
         let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
         // Leave out pixels that see a light directly: the rest is reflected light.
