@@ -4,6 +4,9 @@
 pub mod charts;
 pub mod compositing;
 pub mod config;
+pub mod flip;
+pub mod flip_cells;
+pub mod flip_table;
 #[cfg(test)]
 mod keys_tests;
 pub mod manylights;
@@ -393,6 +396,8 @@ mod tests {
             render: serde_json::json!({}),
             code: Some(code(code_id, false)),
             inputs: None,
+            flip_all: None,
+            flip_unlit: None,
         }
     }
 

@@ -30,6 +30,12 @@ pub struct CellResult {
     pub reference_noise_unlit: f64,
     pub all: Metric,
     pub unlit: Metric,
+    /// Mean HDR-ꟻLIP over all pixels and over the unlit ones (see [`super::flip`]); absent in
+    /// cells from before it was measured (the report computes it when the render is there).
+    #[serde(default)]
+    pub flip_all: Option<f64>,
+    #[serde(default)]
+    pub flip_unlit: Option<f64>,
     pub spp: u64,
     pub wall_seconds: f64,
     pub cpu_seconds: f64,
@@ -277,7 +283,7 @@ pub fn format_time_table(
     s
 }
 
-pub const CSV_HEADER: [&str; 29] = [
+pub const CSV_HEADER: [&str; 31] = [
     "id",
     "scene",
     "strategy",
@@ -295,6 +301,8 @@ pub const CSV_HEADER: [&str; 29] = [
     "mse_unlit",
     "rel_mse_all",
     "mse_all",
+    "flip_unlit",
+    "flip_all",
     "unlit_pixels",
     "reference_noise_unlit",
     "rays_camera",
@@ -308,6 +316,11 @@ pub const CSV_HEADER: [&str; 29] = [
     "code_commit",
     "code_dirty",
 ];
+
+/// A value that old cells may lack: empty then.
+fn optional(v: Option<f64>) -> String {
+    v.map(|v| format!("{v:e}")).unwrap_or_default()
+}
 
 pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), String> {
     render_core::output::write_atomically(path, |tmp| {
@@ -337,6 +350,8 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
                 format!("{:e}", c.unlit.mse),
                 format!("{:e}", c.all.rel_mse),
                 format!("{:e}", c.all.mse),
+                optional(c.flip_unlit),
+                optional(c.flip_all),
                 c.unlit.pixels.to_string(),
                 format!("{:e}", c.reference_noise_unlit),
                 c.render["rays"]["camera"].to_string(),

@@ -10,6 +10,7 @@ pub mod encode;
 pub mod markdown;
 
 use super::config::Experiment;
+use super::flip_cells;
 use super::plan::{Budget, slug};
 use super::report::CellResult;
 use glam::Vec3;
@@ -62,6 +63,7 @@ fn scene_data(
     scene: &str,
     cols: &[String],
     cells: &[CellResult],
+    flips: &mut flip_cells::Sources,
 ) -> Result<Value, String> {
     let seed = exp.seeds.first().copied().unwrap_or(0);
     let mine: Vec<&CellResult> = cells
@@ -112,12 +114,21 @@ fn scene_data(
                 ),
                 None => (Value::Null, Value::Null),
             };
+            // the harness's HDR-ꟻLIP map of this render (ꟻLIP is not computed in the page)
+            let flip_map = match image {
+                Value::Null => Value::Null,
+                _ => flips
+                    .map_png(c)
+                    .map_or(Value::Null, |b| Value::String(encode::data_uri(&b))),
+            };
             items.push(json!({
                 "strategy": col,
                 "budget": label,
                 "id": c.id,
                 "seed": c.seed,
                 "rel_mse": c.unlit.rel_mse,
+                "flip": c.flip_unlit,
+                "flip_map": flip_map,
                 "spp": c.spp,
                 "seconds": c.seconds(exp.budget_clock),
                 "image": image,
@@ -125,15 +136,18 @@ fn scene_data(
             }));
         }
     }
-    let error_maps: Vec<Value> = cols
-        .iter()
-        .filter_map(|col| {
-            let src = format!("error-maps/{}__{}.png", slug(scene), slug(col));
-            out.join(&src)
-                .is_file()
-                .then(|| json!({ "strategy": col, "src": src }))
-        })
-        .collect();
+    let maps_in = |dir: &str| -> Vec<Value> {
+        cols.iter()
+            .filter_map(|col| {
+                let src = format!("{dir}/{}__{}.png", slug(scene), slug(col));
+                out.join(&src)
+                    .is_file()
+                    .then(|| json!({ "strategy": col, "src": src }))
+            })
+            .collect()
+    };
+    let error_maps = maps_in("error-maps");
+    let flip_maps = maps_in("flip-maps");
     let strip_budget = exp
         .spp
         .iter()
@@ -158,12 +172,14 @@ fn scene_data(
         "reference": reference,
         "cells": items,
         "error_maps": error_maps,
+        "flip_maps": flip_maps,
         "error_maps_budget": format!("{strip_budget}, seed {seed}"),
     }))
 }
 
 /// Writes `out/index.html` and `out/viewer/<scene>.js` for the scenes `rows` and the strategy
-/// columns `cols`; `md` is table.md, shown below the viewer.
+/// columns `cols`; `md` is table.md, shown below the viewer; `flips` gives the cells' ꟻLIP maps.
+#[allow(clippy::too_many_arguments)]
 pub fn write(
     exp: &Experiment,
     out: &Path,
@@ -172,12 +188,13 @@ pub fn write(
     cols: &[String],
     cells: &[CellResult],
     md: &str,
+    flips: &mut flip_cells::Sources,
 ) -> Result<(), String> {
     let dir = out.join("viewer");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let mut scripts = Vec::new();
     for scene in rows {
-        let data = scene_data(exp, out, refs_dir, scene, cols, cells)?;
+        let data = scene_data(exp, out, refs_dir, scene, cols, cells, flips)?;
         let file = format!("{}.js", slug(scene));
         // `</` cannot end a script that is a file of its own, but keep the data inert anyway
         let text = format!(
@@ -228,10 +245,12 @@ fn page(exp: &Experiment, scripts: &[String], md: &str) -> String {
          <div id=\"split\"></div><span class=\"tag\" id=\"tagA\"></span><span class=\"tag\" id=\"tagB\"></span></div>\n\
          <p id=\"info\"></p>\n\
          <p class=\"keys\">Wheel: zoom at the cursor; drag: pan; double-click or f: fit. 0–9: A, shift+0–9: B; \
-         space: flip A/B; s: swipe (the split follows the mouse); e: error map; −/+: exposure. \
-         Error maps: per-pixel relMSE (x − r)² / (r² + 0.01), log scale 1e-4<span id=\"legend\"></span>10, \
-         grey where the camera sees a light.</p>\n\
-         <h3 id=\"mapsTitle\"></h3>\n<div id=\"maps\"></div>\n</section>\n",
+         space: flip A/B; s: swipe (the split follows the mouse); e: relMSE map; l: ꟻLIP map; −/+: exposure. \
+         relMSE maps: per-pixel (x − r)² / (r² + 0.01), log scale 1e-4<span id=\"legend\"></span>10, \
+         grey where the camera sees a light. ꟻLIP maps: the harness's per-pixel HDR-ꟻLIP from the full-precision \
+         render, magma 0 (black) to 1 (yellow-white), every pixel.</p>\n\
+         <h3 id=\"mapsTitle\"></h3>\n<div id=\"maps\"></div>\n\
+         <h3 id=\"flipMapsTitle\"></h3>\n<div id=\"flipMaps\"></div>\n</section>\n",
     );
     h.push_str("<section id=\"tables\">\n");
     // table.md's own title is the page's
