@@ -449,6 +449,42 @@ mod tests {
     }
 
     #[test]
+    fn csv_round_trips_flip_and_leaves_it_empty_for_old_cells() {
+        let mut a = crate::experiments::tests::cell_result("a", "r", "tree:x");
+        a.flip_unlit = Some(0.123_456_789_012_345_6);
+        a.flip_all = Some(1.0 / 3.0);
+        a.unlit.rel_mse = 2.5e-3;
+        let b = crate::experiments::tests::cell_result("b", "r", "tree:x");
+        let path = std::env::temp_dir().join(format!("xtask-csv-{}.csv", std::process::id()));
+        write_csv(&path, &[a.clone(), b]).unwrap();
+        let mut r = csv::Reader::from_path(&path).unwrap();
+        let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        assert_eq!(header, CSV_HEADER);
+        let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+        let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+        let parse = |row: &csv::StringRecord, name: &str| -> Option<f64> {
+            let v = &row[col(name)];
+            (!v.is_empty()).then(|| v.parse().unwrap())
+        };
+        assert_eq!(rows.len(), 2);
+        assert_eq!(&rows[0][col("id")], "a");
+        // exactly the values written, and nothing for a cell measured before ꟻLIP
+        assert_eq!(parse(&rows[0], "flip_unlit"), a.flip_unlit);
+        assert_eq!(parse(&rows[0], "flip_all"), a.flip_all);
+        assert_eq!(parse(&rows[0], "rel_mse_unlit"), Some(a.unlit.rel_mse));
+        assert_eq!(parse(&rows[1], "flip_unlit"), None);
+        assert_eq!(parse(&rows[1], "flip_all"), None);
+        // and a cell file of before ꟻLIP (no such keys) still loads
+        let mut old = serde_json::to_value(&a).unwrap();
+        let o = old.as_object_mut().unwrap();
+        o.remove("flip_all");
+        o.remove("flip_unlit");
+        let back: CellResult = serde_json::from_value(old).unwrap();
+        assert_eq!((back.flip_all, back.flip_unlit), (None, None));
+        let _ = std::fs::remove_file(&path);
+    }
+
+    #[test]
     fn time_table() {
         let rows = vec!["s".to_string()];
         let cols = vec!["a".to_string()];
