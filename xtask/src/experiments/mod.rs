@@ -15,6 +15,8 @@ pub mod provenance;
 pub mod reference;
 pub mod report;
 pub mod run;
+#[cfg(test)]
+mod shards_tests;
 pub mod summary;
 pub mod viewer;
 
