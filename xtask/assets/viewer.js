@@ -103,9 +103,16 @@ const MLV = (() => {
     const out = g.createImageData(w, h), o = out.data;
     if (!it || !it.image) { g.fillStyle = "#555"; g.fillRect(0, 0, w, h); return; }
     if (st.view === "flip" && name !== "reference") {
+      // a grey PNG of magma palette indices (viewer/mod.rs): colour it
       const img = it.flip_map ? await loadImage(it.flip_map) : null;
-      if (img) g.drawImage(img, 0, 0, w, h);
-      else { g.fillStyle = "#555"; g.fillRect(0, 0, w, h); }
+      if (!img) { g.fillStyle = "#555"; g.fillRect(0, 0, w, h); return; }
+      g.drawImage(img, 0, 0, w, h);
+      const d = g.getImageData(0, 0, w, h).data, pal = scene.flip_palette;
+      for (let i = 0; i < w * h; i++) {
+        const k = 3 * d[4 * i];
+        o[4 * i] = pal[k]; o[4 * i + 1] = pal[k + 1]; o[4 * i + 2] = pal[k + 2]; o[4 * i + 3] = 255;
+      }
+      g.putImageData(out, 0, 0);
       return;
     }
     const px = await decode(it.image, w, h);

@@ -176,6 +176,25 @@ pub fn magma_rgb(map: &[f32], w: u32, h: u32) -> Vec<u8> {
         .to_vec()
 }
 
+/// The crate's magma colours: 256 RGB8 triples; a map value v has colour ⌊255 v + ½⌋.
+pub fn magma_palette() -> Vec<u8> {
+    nv_flip::magma_lut().to_vec()
+}
+
+/// The palette indices of a magma RGB8 image (each pixel's entry of [`magma_palette`]), so that
+/// the report can embed it as a one-channel PNG a third the size; `None` if a colour is not in
+/// the palette.
+pub fn magma_indices(rgb: &[u8]) -> Option<Vec<u8>> {
+    let palette = magma_palette();
+    let index: std::collections::HashMap<&[u8], u8> = palette
+        .chunks(3)
+        .enumerate()
+        .rev() // a colour listed twice maps to its first index
+        .map(|(i, c)| (c, i as u8))
+        .collect();
+    rgb.chunks(3).map(|c| index.get(c).copied()).collect()
+}
+
 /// Writes `map` as a magma PNG.
 pub fn save_map(path: &Path, map: &[f32], w: u32, h: u32) -> Result<(), String> {
     super::compositing::save_png(path, w, h, &magma_rgb(map, w, h))
@@ -279,6 +298,23 @@ mod tests {
         assert!(hdr_flip_map(&r, &r[..8], 4, 4).is_err());
         assert!(hdr_flip_map(&[], &[], 0, 0).is_err());
         assert!(score(&r, &r, &[true; 3], 4, 4).is_err());
+    }
+
+    #[test]
+    fn magma_maps_back_to_its_indices() {
+        let map: Vec<f32> = (0..256).map(|i| i as f32 / 255.0).collect();
+        let rgb = magma_rgb(&map, 16, 16);
+        let idx = magma_indices(&rgb).unwrap();
+        let palette = magma_palette();
+        assert_eq!(palette.len(), 768);
+        // the palette applied to the indices gives the magma image back
+        let back: Vec<u8> = idx
+            .iter()
+            .flat_map(|&i| palette[3 * i as usize..3 * i as usize + 3].to_vec())
+            .collect();
+        assert_eq!(back, rgb);
+        assert_eq!((idx[0], idx[255]), (0, 255));
+        assert!(magma_indices(&[1, 2, 3]).is_none() || palette.chunks(3).any(|c| c == [1, 2, 3]));
     }
 
     #[test]

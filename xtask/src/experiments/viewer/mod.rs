@@ -41,6 +41,17 @@ fn unlit_uri(unlit: &[bool], w: u32, h: u32) -> Result<String, String> {
     Ok(encode::data_uri(&encode::png_bytes(&buf, w, h, 1)?))
 }
 
+/// A ꟻLIP map (magma PNG bytes) as the page's data URI: its palette indices as a grey PNG,
+/// a third of the magma PNG's size (the page applies `flip_palette`).
+fn flip_map_uri(png: &[u8], w: u32, h: u32) -> Option<String> {
+    let img = image::load_from_memory(png).ok()?.to_rgb8();
+    if img.dimensions() != (w, h) {
+        return None;
+    }
+    let idx = super::flip::magma_indices(img.as_raw())?;
+    Some(encode::data_uri(&encode::png_bytes(&idx, w, h, 1).ok()?))
+}
+
 /// The render of `cell` (and its own light mask) when renders/ has it at the cell's size.
 fn cell_render(out: &Path, cell: &CellResult) -> Option<(Vec<Vec3>, Option<Vec<bool>>)> {
     let renders = out.join("renders");
@@ -119,7 +130,8 @@ fn scene_data(
                 Value::Null => Value::Null,
                 _ => flips
                     .map_png(c)
-                    .map_or(Value::Null, |b| Value::String(encode::data_uri(&b))),
+                    .and_then(|b| flip_map_uri(&b, w, h))
+                    .map_or(Value::Null, Value::String),
             };
             items.push(json!({
                 "strategy": col,
@@ -173,6 +185,7 @@ fn scene_data(
         "cells": items,
         "error_maps": error_maps,
         "flip_maps": flip_maps,
+        "flip_palette": super::flip::magma_palette(),
         "error_maps_budget": format!("{strip_budget}, seed {seed}"),
     }))
 }

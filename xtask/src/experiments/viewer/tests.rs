@@ -277,9 +277,20 @@ fn report_page_is_well_formed_and_complete() {
             .iter()
             .find(|(id, _)| c["id"] == id.as_str())
             .unwrap();
-        // its ꟻLIP map, as the harness wrote it
-        let f = png_of(c["flip_map"].as_str().unwrap()).to_rgb8();
+        // its ꟻLIP map, as the harness wrote it: palette indices that colour to the magma PNG
+        let f = png_of(c["flip_map"].as_str().unwrap()).to_luma8();
         assert_eq!(f.dimensions(), (w, h));
+        let pal: Vec<u8> = serde_json::from_value(data["flip_palette"].clone()).unwrap();
+        let coloured: Vec<u8> = f
+            .as_raw()
+            .iter()
+            .flat_map(|&i| pal[3 * i as usize..3 * i as usize + 3].to_vec())
+            .collect();
+        let path = out
+            .join("renders")
+            .join(format!("{}.flip.png", c["id"].as_str().unwrap()));
+        let magma = image::open(path).unwrap().to_rgb8().into_raw();
+        assert_eq!(coloured, magma);
         let img = png_of(c["image"].as_str().unwrap()).to_rgb8();
         assert_eq!(img.dimensions(), (w, 2 * h));
         let back = encode::decode_split(&img.into_raw(), w, h);
