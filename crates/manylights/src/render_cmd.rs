@@ -34,13 +34,6 @@ pub struct RenderArgs {
     /// pixel within the radius, which `--reproduce` implies).
     #[arg(long, value_parser = reconstruction_parser())]
     pub reconstruction: Option<Reconstruction>,
-    /// Camera rays per sample that gather the emission seen directly, at the pixels that may
-    /// straddle a light's edge (every pixel in the first pass, then those near a light not yet
-    /// seen to be fully inside one): 1 (the default) traces only the sample's own ray; more
-    /// lowers the noise of a pixel's coverage of the lights, which light sampling never touches.
-    /// Needs the sampled reconstruction.
-    #[arg(long, default_value_t = 1, value_parser = emission_rays_parser)]
-    pub emission_rays: u32,
     #[arg(long)]
     pub width: Option<u32>,
     #[arg(long)]
@@ -78,7 +71,7 @@ pub struct RenderArgs {
     pub quiet: bool,
 }
 
-/// What determines the strategy a render uses: its name, its knobs and the sampler
+/// What determines the strategy a render uses: its name, its knobs, the sampler and the emission rays
 /// (`manylights strategy` takes the same flags and prints them resolved).
 #[derive(Args, Debug, Clone)]
 pub struct StrategyArgs {
@@ -91,6 +84,13 @@ pub struct StrategyArgs {
     /// scene file's own `Sampler` is used when this is not given.
     #[arg(long, value_parser = sampler_parser())]
     pub sampler: Option<Sampler>,
+    /// Camera rays per sample that gather the emission seen directly, at the pixels that may
+    /// straddle a light's edge (every pixel in the first pass, then those near a light not yet
+    /// seen to be fully inside one): 1 (the default) traces only the sample's own ray; more
+    /// lowers the noise of a pixel's coverage of the lights, which light sampling never touches.
+    /// Needs the sampled reconstruction.
+    #[arg(long, default_value_t = 1, value_parser = emission_rays_parser)]
+    pub emission_rays: u32,
     /// Adaptive tree splitting threshold τ (tree-split and mis3 strategies) [default: 0.35, the
     /// authors' 0.85 with --reproduce].
     #[arg(long)]
@@ -117,6 +117,7 @@ impl StrategyArgs {
             "strategy": self.strategy,
             "parameters": parameters,
             "sampler": self.sampler.map(Sampler::name),
+            "emission_rays": self.emission_rays,
         }))
     }
 }
@@ -386,13 +387,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         sampler,
         filter: filter.clone(),
         reconstruction,
-        emission_rays: EmissionRays::new(args.emission_rays).map_err(anyhow::Error::msg)?,
+        emission_rays: EmissionRays::new(args.strategy.emission_rays)
+            .map_err(anyhow::Error::msg)?,
     };
     if settings.emission_rays != EmissionRays::OFF && reconstruction == Reconstruction::Splat {
         bail!(
             "--emission-rays {} needs the sampled reconstruction, but {reconstruction_from} chose \
              splatting: add --reconstruction sampled",
-            args.emission_rays
+            args.strategy.emission_rays
         );
     }
     let bar = if args.quiet {
@@ -481,7 +483,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             "reconstruction": reconstruction.name(),
             "reconstruction_from": reconstruction_from,
         },
-        "emission_rays": args.emission_rays,
+        "emission_rays": args.strategy.emission_rays,
         "width": width,
         "height": height,
         "camera": camera,
