@@ -24,6 +24,7 @@ pub mod alias;
 pub mod brdf_oriented;
 pub mod bsdf_sampling;
 pub mod convergence;
+pub mod learned;
 pub mod light_strategy;
 mod memo;
 pub mod mis;
@@ -230,6 +231,11 @@ pub fn strategies() -> Vec<StrategyInfo> {
             "Liu et al. 2019: three-technique MIS with adaptive allocation",
         ),
         s(
+            "learned",
+            "learned cluster selection (issue 25): a fixed 64-cluster cut, each cluster weighed by the tree importance × the visibility learnt per region in earlier passes (+20 % the tree importance alone), then the tree's descent",
+        ),
+        s("learned+bsdf", "learned + BSDF sampling, MIS"),
+        s(
             "oracle",
             "every light's unshadowed contribution per point, one light chosen ∝ it (+5 % power), + BSDF sampling, MIS: a floor, O(lights) per point",
         ),
@@ -327,6 +333,16 @@ pub fn create(
         }),
         "bsdf" => Box::new(BsdfStrategy),
         "brdf-oriented" | "mis3-equal" | "mis3-adaptive" => mis3(name, scene, opts)?,
+        "learned" | "learned+bsdf" => Box::new(learned::strategy::LearnedStrategy {
+            name: name.into(),
+            selection: learned::selection::LearnedSelection::new(
+                scene,
+                units,
+                learned::LearnedConfig::default(),
+            )
+            .map_err(StrategyError::BadOption)?,
+            with_bsdf: name == "learned+bsdf",
+        }),
         "oracle" => Box::new(LightStrategy {
             name: name.into(),
             selection: oracle::OracleSelection::new(scene),
