@@ -170,10 +170,15 @@ impl RegionTable {
 
     /// Merges the observations the pass just finished left in the pixels' memory (in pixel
     /// order), then counts the pass as merged.
-    pub fn merge_pass<'a>(&mut self, pixels: &mut dyn Iterator<Item = &'a [f32; PIXEL_MEMORY]>) {
+    /// `base`: the first of the observation's slots in the pixel memory.
+    pub fn merge_pass<'a>(
+        &mut self,
+        pixels: &mut dyn Iterator<Item = &'a [f32; PIXEL_MEMORY]>,
+        base: usize,
+    ) {
         let stamp = self.pass + 1;
         for m in pixels {
-            if let Some(o) = Observation::read(m, stamp)
+            if let Some(o) = Observation::read(&m[base..], stamp)
                 && o.cluster < self.clusters
             {
                 self.add(o.key, o.cluster, o.hit);
@@ -195,12 +200,12 @@ pub struct Observation {
 }
 
 /// Pixel-memory slots: the pass stamp, three 21-bit parts of the key, the cluster, the hit.
-const SLOTS: usize = 6;
+pub const SLOTS: usize = 6;
 const _: () = assert!(SLOTS <= PIXEL_MEMORY);
 
 impl Observation {
     /// Writes the observation under pass stamp `stamp` (every value an exact integer).
-    pub fn write(&self, memory: &mut [f32; PIXEL_MEMORY], stamp: u32) {
+    pub fn write(&self, memory: &mut [f32], stamp: u32) {
         let mask = (1u64 << KEY_PART_BITS) - 1;
         memory[0] = stamp as f32;
         for j in 0..3 {
@@ -211,12 +216,12 @@ impl Observation {
     }
 
     /// Marks the pixel as having no observation in this pass.
-    pub fn clear(memory: &mut [f32; PIXEL_MEMORY]) {
+    pub fn clear(memory: &mut [f32]) {
         memory[0] = 0.0;
     }
 
     /// The observation written under `stamp`, if any (older passes' are ignored).
-    pub fn read(memory: &[f32; PIXEL_MEMORY], stamp: u32) -> Option<Observation> {
+    pub fn read(memory: &[f32], stamp: u32) -> Option<Observation> {
         if memory[0] != stamp as f32 {
             return None;
         }

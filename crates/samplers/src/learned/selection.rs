@@ -76,6 +76,8 @@ pub struct LearnedState {
     tree: TreeState,
     /// The region of the shading point.
     pub key: u64,
+    /// The stamp of the pass being drawn (the passes merged into the table + 1).
+    pub stamp: u32,
     /// Unnormalised probability of each cluster; `total` is their sum.
     q: [f32; MAX_CLUSTERS],
     total: f64,
@@ -110,6 +112,7 @@ impl LearnedSelection {
         let mut state = LearnedState {
             tree,
             key,
+            stamp: table.pass + 1,
             q: [0.0; MAX_CLUSTERS],
             total: 0.0,
         };

@@ -61,11 +61,12 @@ impl DirectLighting for LearnedStrategy {
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let sel = &self.selection;
-        let (state, stamp) = {
+        let state = {
             let table = sel.table.read().unwrap_or_else(|e| e.into_inner());
-            (sel.prepare_with(scene, sp, &table), table.pass + 1)
+            sel.prepare_with(scene, sp, &table)
         };
-        Observation::clear(ctx.pixel_memory);
+        let stamp = state.stamp;
+        Observation::clear(&mut ctx.pixel_memory[..]);
         ctx.counters
             .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
         let mut picks = Pooled::<Picks>::take();
@@ -87,7 +88,7 @@ impl DirectLighting for LearnedStrategy {
                 let o = sp.origin_towards(s.wi);
                 let hit = !scene.occluded(o, s.wi, (s.point - o).length());
                 if let Some(cluster) = sel.cluster_of(light) {
-                    record(ctx.pixel_memory, state.key, cluster, hit, stamp);
+                    record(&mut ctx.pixel_memory[..], state.key, cluster, hit, stamp);
                 }
                 if hit {
                     let w = if self.with_bsdf && !s.is_delta {
@@ -125,10 +126,10 @@ impl DirectLighting for LearnedStrategy {
             .table
             .write()
             .unwrap_or_else(|e| e.into_inner())
-            .merge_pass(pixel_memory);
+            .merge_pass(pixel_memory, 0);
     }
 }
 
-fn record(memory: &mut [f32; PIXEL_MEMORY], key: u64, cluster: usize, hit: bool, stamp: u32) {
+fn record(memory: &mut [f32], key: u64, cluster: usize, hit: bool, stamp: u32) {
     Observation { key, cluster, hit }.write(memory, stamp);
 }
