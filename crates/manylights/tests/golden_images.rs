@@ -146,6 +146,7 @@ fn scenes(dir: &Path) -> Vec<(String, Scene)> {
         "cornell",
         "staircase",
         "grid",
+        "rooms",
     ];
     let mut out: Vec<(String, Scene)> = builtins
         .iter()
