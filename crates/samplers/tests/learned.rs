@@ -44,6 +44,7 @@ fn settings(scene: &Scene, (w, h): (u32, u32), spp: u32, threads: usize) -> Rend
         sampler: Default::default(),
         filter: Default::default(),
         reconstruction: Default::default(),
+        emission_rays: Default::default(),
     }
 }
 
