@@ -1,6 +1,7 @@
 // The experiment report's image viewer (xtask/src/experiments/viewer): per scene the reference
 // and each strategy at each budget, flip (A/B) or swipe, zoom and pan with sharp pixels, an
-// exposure control applied to linear values, and per-pixel relMSE maps computed here.
+// exposure control applied to linear values, per-pixel relMSE maps computed here, and the
+// harness's HDR-ꟻLIP maps (magma PNGs made from the full-precision renders).
 // Images come as RGBE split PNGs in data URIs (viewer/encode.rs): a data URI does not taint a
 // canvas under file://, so the linear values can be read back.
 "use strict";
@@ -61,6 +62,20 @@ const MLV = (() => {
     return p;
   }
 
+  // An ordinary PNG (a ꟻLIP map) as an image element, once.
+  function loadImage(uri) {
+    const key = "img:" + uri;
+    if (decoded.has(key)) return decoded.get(key);
+    const p = new Promise((ok) => {
+      const img = new Image();
+      img.onload = () => ok(img);
+      img.onerror = () => ok(null);
+      img.src = uri;
+    });
+    decoded.set(key, p);
+    return p;
+  }
+
   const srgb = (c) => {
     c = c > 0 ? (c < 1 ? c : 1) : 0;
     return 255 * (c <= 0.0031308 ? 12.92 * c : 1.055 * Math.pow(c, 1 / 2.4) - 0.055) + 0.5;
@@ -87,6 +102,19 @@ const MLV = (() => {
     const g = canvas.getContext("2d");
     const out = g.createImageData(w, h), o = out.data;
     if (!it || !it.image) { g.fillStyle = "#555"; g.fillRect(0, 0, w, h); return; }
+    if (st.view === "flip" && name !== "reference") {
+      // a grey PNG of magma palette indices (viewer/mod.rs): colour it
+      const img = it.flip_map ? await loadImage(it.flip_map) : null;
+      if (!img) { g.fillStyle = "#555"; g.fillRect(0, 0, w, h); return; }
+      g.drawImage(img, 0, 0, w, h);
+      const d = g.getImageData(0, 0, w, h).data, pal = scene.flip_palette;
+      for (let i = 0; i < w * h; i++) {
+        const k = 3 * d[4 * i];
+        o[4 * i] = pal[k]; o[4 * i + 1] = pal[k + 1]; o[4 * i + 2] = pal[k + 2]; o[4 * i + 3] = 255;
+      }
+      g.putImageData(out, 0, 0);
+      return;
+    }
     const px = await decode(it.image, w, h);
     if (st.view === "error" && name !== "reference" && scene.reference) {
       const ref = await decode(scene.reference.image, w, h);
@@ -118,7 +146,8 @@ const MLV = (() => {
     const it = item(scene, name);
     if (name === "reference") return scene.reference ? "reference: " + scene.reference.caption : "reference (not on this machine)";
     if (!it) return name + ": no cell";
-    let s = name + ": relMSE " + it.rel_mse.toExponential(2) + ", " + it.spp + " spp, " + it.seconds.toFixed(2) + " s, seed " + it.seed;
+    let s = name + ": relMSE " + it.rel_mse.toExponential(2) +
+      (it.flip != null ? ", ꟻLIP " + it.flip.toFixed(4) : "") + ", " + it.spp + " spp, " + it.seconds.toFixed(2) + " s, seed " + it.seed;
     if (!it.image) s += " (render not on this machine)";
     return s;
   }
@@ -190,7 +219,10 @@ const MLV = (() => {
     button(r5, "flip A/B (space)", st.mode === "flip", () => { st.mode = "flip"; update(); });
     button(r5, "swipe (s)", st.mode === "swipe", () => { st.mode = "swipe"; update(); });
     button(r5, "image", st.view === "image", () => { st.view = "image"; update(); });
-    button(r5, "error map (e)", st.view === "error", () => { st.view = "error"; update(); }, !scene.reference);
+    button(r5, "relMSE map (e)", st.view === "error", () => { st.view = "error"; update(); }, !scene.reference);
+    const anyFlip = scene.cells.some((c) => c.budget === scene.budgets[st.budget] && c.flip_map);
+    button(r5, "ꟻLIP map (l)", st.view === "flip", () => { st.view = "flip"; update(); }, !anyFlip,
+           anyFlip ? "" : "no ꟻLIP maps: the renders are not on this machine");
     button(r5, "fit (f)", false, fit);
     const r6 = row("exposure");
     const range = document.createElement("input");
@@ -208,7 +240,8 @@ const MLV = (() => {
     $("tagB").textContent = st.mode === "swipe" ? "B: " + st.b : "";
     $("tagB").style.display = st.mode === "swipe" ? "block" : "none";
     $("info").textContent = showing + " — A = " + caption(scene, st.a) + " | B = " + caption(scene, st.b) +
-      (st.view === "error" ? " | per-pixel relMSE against the reference (from the previews, ≈1 % precision)" : "");
+      (st.view === "error" ? " | per-pixel relMSE against the reference (from the previews, ≈1 % precision)" : "") +
+      (st.view === "flip" ? " | HDR-ꟻLIP against the reference (the harness's, from the full-precision renders)" : "");
     $("note").textContent = scene.cells.some((c) => c.image) ? "" :
       "The cells' renders (results/<experiment>/renders/, not committed) were not on the machine that wrote this page: only the reference, the harness's error maps, the tables and the plots are shown. Rerun the experiment to see every render.";
     maps(scene);
@@ -217,17 +250,21 @@ const MLV = (() => {
   }
 
   function maps(scene) {
-    const m = $("maps");
-    m.textContent = "";
-    $("mapsTitle").textContent = scene.error_maps.length
-      ? "Error maps of " + scene.label + " computed by the harness from the full-precision renders (" + scene.error_maps_budget + ")"
-      : "";
-    for (const e of scene.error_maps) {
-      const f = document.createElement("figure");
-      const img = document.createElement("img");
-      img.className = "px"; img.src = e.src; img.alt = e.strategy;
-      const c = document.createElement("figcaption"); c.textContent = e.strategy;
-      f.appendChild(img); f.appendChild(c); m.appendChild(f);
+    const lists = [["maps", "mapsTitle", scene.error_maps, "relMSE maps"],
+                   ["flipMaps", "flipMapsTitle", scene.flip_maps || [], "HDR-ꟻLIP maps"]];
+    for (const [box, title, list, what] of lists) {
+      const m = $(box);
+      m.textContent = "";
+      $(title).textContent = list.length
+        ? what + " of " + scene.label + " computed by the harness from the full-precision renders (" + scene.error_maps_budget + ")"
+        : "";
+      for (const e of list) {
+        const f = document.createElement("figure");
+        const img = document.createElement("img");
+        img.className = "px"; img.src = e.src; img.alt = e.strategy;
+        const c = document.createElement("figcaption"); c.textContent = e.strategy;
+        f.appendChild(img); f.appendChild(c); m.appendChild(f);
+      }
     }
   }
 
@@ -275,6 +312,7 @@ const MLV = (() => {
       } else if (e.key === " ") { e.preventDefault(); st.showB = !st.showB; transform(); update(); return; }
       else if (e.key === "s") st.mode = st.mode === "swipe" ? "flip" : "swipe";
       else if (e.key === "e") st.view = st.view === "error" ? "image" : "error";
+      else if (e.key === "l") st.view = st.view === "flip" ? "image" : "flip";
       else if (e.key === "f") { fit(); return; }
       else if (e.key === "-") st.stops -= 0.5;
       else if (e.key === "+" || e.key === "=") st.stops += 0.5;

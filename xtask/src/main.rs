@@ -1,6 +1,7 @@
 //! Project automation (the `cargo xtask` pattern). Subcommands are added by the issues that need them.
 mod contact_sheet;
 mod experiments;
+mod flip_cmd;
 mod fuzz;
 mod glossy_mask;
 
@@ -13,7 +14,7 @@ fn main() -> std::process::ExitCode {
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  fuzz [--minutes N] [--seed S] [--case K]    fuzz the scene loaders (crates/scene-fuzz) for N minutes\n  glossy-mask SCENE W H OUT.png [--max-alpha A]    mask of the pixels whose camera ray sees GGX α < A"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] …    render an experiment (default `quick`) into results/NAME/ (see xtask/README.md)\n  merge-results [--experiment NAME] [SHARD_DIRS…]    merge shard results and regenerate the report\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  flip IMAGE.exr REFERENCE.exr [--mask M.png]… [--map OUT.png] [--json]    HDR-ꟻLIP of a render against a reference (the harness's metric)\n  fuzz [--minutes N] [--seed S] [--case K]    fuzz the scene loaders (crates/scene-fuzz) for N minutes\n  glossy-mask SCENE W H OUT.png [--max-alpha A]    mask of the pixels whose camera ray sees GGX α < A"
             );
         }
         Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
@@ -35,6 +36,7 @@ fn main() -> std::process::ExitCode {
         // issue 7: every scene on one sheet
         Some("contact-sheet") => return contact_sheet::main(&args),
         Some("glossy-mask") => return glossy_mask::main(&args),
+        Some("flip") => return flip_cmd::main(&args),
         Some("fuzz") => return fuzz::main(&args),
         Some(other) => {
             eprintln!("error: unknown xtask command `{other}` (try `cargo xtask help`)");

@@ -55,6 +55,7 @@ fn render_case(scene: &Scene, strategy: &str, opts: &StrategyOptions) -> u64 {
         sampler: Default::default(),
         filter: Default::default(),
         reconstruction: Default::default(),
+        emission_rays: Default::default(),
     };
     hash_render(&render(scene, s.as_ref(), &settings, &|_, _| {}).unwrap())
 }
@@ -145,6 +146,7 @@ fn scenes(dir: &Path) -> Vec<(String, Scene)> {
         "cornell",
         "staircase",
         "grid",
+        "rooms",
     ];
     let mut out: Vec<(String, Scene)> = builtins
         .iter()

@@ -9,7 +9,7 @@ use glam::Vec3;
 /// Most per-pixel diagnostic channels a strategy can write.
 pub const MAX_AUX: usize = 4;
 /// Floats of per-pixel memory a strategy may keep across passes of the same pixel.
-pub const PIXEL_MEMORY: usize = 10;
+pub const PIXEL_MEMORY: usize = 16;
 
 /// A camera-ray hit on a reflecting surface, ready for direct lighting.
 #[derive(Clone, Copy, Debug)]

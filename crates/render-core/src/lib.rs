@@ -14,6 +14,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod colour;
+pub mod emission_rays;
 pub mod error;
 pub mod estimator;
 pub mod frame;

@@ -7,6 +7,8 @@ pub const MAX_TECHNIQUES: usize = 8;
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
 pub struct Counters {
     pub camera_rays: u64,
+    /// Of the camera rays, those traced only for the emission they see (`emission_rays.rs`).
+    pub emission_rays: u64,
     pub shadow_rays: u64,
     /// Rays traced from BSDF-sampled directions to find the light they hit.
     pub bsdf_rays: u64,
@@ -29,6 +31,7 @@ pub struct Counters {
 impl Counters {
     pub fn merge(&mut self, o: &Counters) {
         self.camera_rays += o.camera_rays;
+        self.emission_rays += o.emission_rays;
         self.shadow_rays += o.shadow_rays;
         self.bsdf_rays += o.bsdf_rays;
         self.shading_points += o.shading_points;

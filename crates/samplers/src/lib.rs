@@ -24,6 +24,7 @@ pub mod alias;
 pub mod brdf_oriented;
 pub mod bsdf_sampling;
 pub mod convergence;
+pub mod learned;
 pub mod light_strategy;
 mod memo;
 pub mod mis;
@@ -230,6 +231,15 @@ pub fn strategies() -> Vec<StrategyInfo> {
             "Liu et al. 2019: three-technique MIS with adaptive allocation",
         ),
         s(
+            "mis3-adaptive-learned",
+            "mis3-adaptive with the learned cluster selection (issue 25) as its LS technique at every point",
+        ),
+        s(
+            "learned",
+            "learned cluster selection (issue 25): a fixed 64-cluster cut, each cluster weighed by the tree importance × the visibility learnt per region in earlier passes (+20 % the tree importance alone), then the tree's descent",
+        ),
+        s("learned+bsdf", "learned + BSDF sampling, MIS"),
+        s(
             "oracle",
             "every light's unshadowed contribution per point, one light chosen ∝ it (+5 % power), + BSDF sampling, MIS: a floor, O(lights) per point",
         ),
@@ -326,7 +336,19 @@ pub fn create(
             parameters: serde_json::Value::Null,
         }),
         "bsdf" => Box::new(BsdfStrategy),
-        "brdf-oriented" | "mis3-equal" | "mis3-adaptive" => mis3(name, scene, opts)?,
+        "brdf-oriented" | "mis3-equal" | "mis3-adaptive" | "mis3-adaptive-learned" => {
+            mis3(name, scene, opts)?
+        }
+        "learned" | "learned+bsdf" => Box::new(learned::strategy::LearnedStrategy {
+            name: name.into(),
+            selection: learned::selection::LearnedSelection::new(
+                scene,
+                units,
+                learned::LearnedConfig::default(),
+            )
+            .map_err(StrategyError::BadOption)?,
+            with_bsdf: name == "learned+bsdf",
+        }),
         "oracle" => Box::new(LightStrategy {
             name: name.into(),
             selection: oracle::OracleSelection::new(scene),
@@ -370,6 +392,18 @@ fn mis3(
     )
     .map_err(StrategyError::BadOption)?;
     let config = resolve::bo_config(opts);
+    let learned = if name == "mis3-adaptive-learned" {
+        Some(
+            learned::selection::LearnedSelection::new(
+                scene,
+                opts.power_units(),
+                learned::LearnedConfig::default(),
+            )
+            .map_err(StrategyError::BadOption)?,
+        )
+    } else {
+        None
+    };
     let sg_nodes = match (opts.bo_importance, &ls.tree) {
         (brdf_oriented::BoImportance::Sg, Some(tree)) => Some(
             light_tree::SgNodes::build(tree, &sg::sg_emitters(scene))
@@ -380,6 +414,7 @@ fn mis3(
     Ok(match opts.brdf_integral {
         BrdfIntegral::Sptd => Box::new(Mis3 {
             sg_nodes,
+            learned,
             ..Mis3::new(name.into(), mode, ls, resolve::sptd(opts), config)
         }),
         BrdfIntegral::Ltc => {
@@ -394,6 +429,7 @@ fn mis3(
             }
             Box::new(Mis3 {
                 sg_nodes,
+                learned,
                 ..Mis3::new(name.into(), mode, ls, integral, config)
             })
         }

@@ -113,6 +113,18 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
             "method": bo_config(opts),
             "integral": integral(opts),
         }),
+        "mis3-adaptive-learned" => json!({
+            "power_units": units(opts),
+            "ls": "learned",
+            "learned": crate::learned::LearnedConfig::default(),
+            "method": bo_config(opts),
+            "integral": integral(opts),
+        }),
+        "learned" | "learned+bsdf" => json!({
+            "power_units": units(opts),
+            "cut": "breadth-first",
+            "learned": crate::learned::LearnedConfig::default(),
+        }),
         "oracle" => json!({
             "defensive_power_fraction": oracle::DEFENSIVE,
             "strata_per_side": oracle::STRATA_PER_SIDE,

@@ -246,6 +246,7 @@ fn a_strategy_object_renders_the_same_image_twice() {
         sampler: Default::default(),
         filter: Default::default(),
         reconstruction: Default::default(),
+        emission_rays: Default::default(),
     };
     let a = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
     let b = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
@@ -285,6 +286,7 @@ fn bisml_cornell_from_pbrt_agrees_with_its_gltf() {
             sampler: Default::default(),
             filter: Default::default(),
             reconstruction: Default::default(),
+            emission_rays: Default::default(),
         };
         render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
     };

@@ -4,6 +4,9 @@
 pub mod charts;
 pub mod compositing;
 pub mod config;
+pub mod flip;
+pub mod flip_cells;
+pub mod flip_table;
 #[cfg(test)]
 mod keys_tests;
 pub mod manylights;
@@ -12,6 +15,8 @@ pub mod provenance;
 pub mod reference;
 pub mod report;
 pub mod run;
+#[cfg(test)]
+mod shards_tests;
 pub mod summary;
 pub mod viewer;
 
@@ -393,6 +398,8 @@ mod tests {
             render: serde_json::json!({}),
             code: Some(code(code_id, false)),
             inputs: None,
+            flip_all: None,
+            flip_unlit: None,
         }
     }
 

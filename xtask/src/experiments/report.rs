@@ -30,6 +30,12 @@ pub struct CellResult {
     pub reference_noise_unlit: f64,
     pub all: Metric,
     pub unlit: Metric,
+    /// Mean HDR-ꟻLIP over all pixels and over the unlit ones (see [`super::flip`]); absent in
+    /// cells from before it was measured (the report computes it when the render is there).
+    #[serde(default)]
+    pub flip_all: Option<f64>,
+    #[serde(default)]
+    pub flip_unlit: Option<f64>,
     pub spp: u64,
     pub wall_seconds: f64,
     pub cpu_seconds: f64,
@@ -277,7 +283,7 @@ pub fn format_time_table(
     s
 }
 
-pub const CSV_HEADER: [&str; 29] = [
+pub const CSV_HEADER: [&str; 31] = [
     "id",
     "scene",
     "strategy",
@@ -295,6 +301,8 @@ pub const CSV_HEADER: [&str; 29] = [
     "mse_unlit",
     "rel_mse_all",
     "mse_all",
+    "flip_unlit",
+    "flip_all",
     "unlit_pixels",
     "reference_noise_unlit",
     "rays_camera",
@@ -308,6 +316,11 @@ pub const CSV_HEADER: [&str; 29] = [
     "code_commit",
     "code_dirty",
 ];
+
+/// A value that old cells may lack: empty then.
+fn optional(v: Option<f64>) -> String {
+    v.map(|v| format!("{v:e}")).unwrap_or_default()
+}
 
 pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), String> {
     render_core::output::write_atomically(path, |tmp| {
@@ -337,6 +350,8 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
                 format!("{:e}", c.unlit.mse),
                 format!("{:e}", c.all.rel_mse),
                 format!("{:e}", c.all.mse),
+                optional(c.flip_unlit),
+                optional(c.flip_all),
                 c.unlit.pixels.to_string(),
                 format!("{:e}", c.reference_noise_unlit),
                 c.render["rays"]["camera"].to_string(),
@@ -431,6 +446,42 @@ mod tests {
             "| s | **2.90e-3** (1.07×) ° | 3.10e-3 (1.00×) | 4.00e-3 | 1.00e-3 |"
         );
         assert_eq!(count_near_reference(&m, &noise), 1);
+    }
+
+    #[test]
+    fn csv_round_trips_flip_and_leaves_it_empty_for_old_cells() {
+        let mut a = crate::experiments::tests::cell_result("a", "r", "tree:x");
+        a.flip_unlit = Some(0.123_456_789_012_345_6);
+        a.flip_all = Some(1.0 / 3.0);
+        a.unlit.rel_mse = 2.5e-3;
+        let b = crate::experiments::tests::cell_result("b", "r", "tree:x");
+        let path = std::env::temp_dir().join(format!("xtask-csv-{}.csv", std::process::id()));
+        write_csv(&path, &[a.clone(), b]).unwrap();
+        let mut r = csv::Reader::from_path(&path).unwrap();
+        let header: Vec<String> = r.headers().unwrap().iter().map(String::from).collect();
+        assert_eq!(header, CSV_HEADER);
+        let col = |name: &str| header.iter().position(|h| h == name).unwrap();
+        let rows: Vec<csv::StringRecord> = r.records().map(Result::unwrap).collect();
+        let parse = |row: &csv::StringRecord, name: &str| -> Option<f64> {
+            let v = &row[col(name)];
+            (!v.is_empty()).then(|| v.parse().unwrap())
+        };
+        assert_eq!(rows.len(), 2);
+        assert_eq!(&rows[0][col("id")], "a");
+        // exactly the values written, and nothing for a cell measured before ꟻLIP
+        assert_eq!(parse(&rows[0], "flip_unlit"), a.flip_unlit);
+        assert_eq!(parse(&rows[0], "flip_all"), a.flip_all);
+        assert_eq!(parse(&rows[0], "rel_mse_unlit"), Some(a.unlit.rel_mse));
+        assert_eq!(parse(&rows[1], "flip_unlit"), None);
+        assert_eq!(parse(&rows[1], "flip_all"), None);
+        // and a cell file of before ꟻLIP (no such keys) still loads
+        let mut old = serde_json::to_value(&a).unwrap();
+        let o = old.as_object_mut().unwrap();
+        o.remove("flip_all");
+        o.remove("flip_unlit");
+        let back: CellResult = serde_json::from_value(old).unwrap();
+        assert_eq!((back.flip_all, back.flip_unlit), (None, None));
+        let _ = std::fs::remove_file(&path);
     }
 
     #[test]

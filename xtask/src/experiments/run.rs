@@ -3,6 +3,7 @@
 //! references, render and measure each cell whose stored result is stale (`execute`), write
 //! the report (`super::finish`).
 use super::config::Experiment;
+use super::flip;
 use super::manylights::{self, Failure, Manylights, repo_root};
 use super::plan::{self, Budget, Cell};
 use super::provenance::{self, CellInputs, CodeState, Permissions};
@@ -633,6 +634,9 @@ fn measure(
         .collect();
     let unlit =
         render_core::metrics::error_metrics(&px, &reference.pixels, Some(&unlit_pixels)).into();
+    // HDR-ꟻLIP beside relMSE; its map is kept beside the render for the report.
+    let flip = flip::score(&px, &reference.pixels, &unlit_pixels, w, h)?;
+    flip::save_map(&exr.with_extension("flip.png"), &flip.map, w, h)?;
     Ok(CellResult {
         id: cell.id(),
         key: cell_key(cell),
@@ -655,6 +659,8 @@ fn measure(
         reference_noise_unlit: reference.manifest.noise_unlit.rel_mse,
         all,
         unlit,
+        flip_all: Some(flip.all),
+        flip_unlit: Some(flip.unlit),
         spp: render["spp"].as_u64().unwrap_or(0),
         wall_seconds: render["wall_seconds"].as_f64().unwrap_or(0.0),
         cpu_seconds: render["cpu_seconds"].as_f64().unwrap_or(0.0),

@@ -3,6 +3,8 @@
 use super::charts::{self, Series};
 use super::compositing::{self, StripColumn};
 use super::config::{BudgetClock, Experiment};
+use super::flip_cells;
+use super::flip_table;
 use super::plan::{self, Budget, slug};
 use super::provenance::{Permissions, Provenance};
 use super::report::{self, CellResult, Entry, Pixels};
@@ -124,15 +126,20 @@ pub fn generate(
     notices: &[Notice],
     perm: &Permissions,
 ) -> Result<(), String> {
-    let cells = load_cells(exp, out);
+    let mut cells = load_cells(exp, out);
     let provenance = Provenance::check(&cells, perm)?;
+    // ꟻLIP of cells measured before it was, where their renders are on this machine
+    let mut flips = flip_cells::Sources::new(out, refs_dir);
+    flips.fill_missing(&mut cells);
     write_cell_files(out, &cells)?;
     let layout = Layout::new(exp, &cells, provenance);
     let mut md = String::new();
     write_header(&mut md, &layout, &cells);
     write_error_tables(&mut md, &layout, &cells, Pixels::Unlit);
+    write_flip_tables(&mut md, &layout, &cells, Pixels::Unlit);
     write_oracle_tables(&mut md, &layout, &cells);
     write_error_tables(&mut md, &layout, &cells, Pixels::All);
+    write_flip_tables(&mut md, &layout, &cells, Pixels::All);
     write_time_tables(&mut md, &layout, &cells);
     write_figures(&mut md, &layout, &cells, out, refs_dir)?;
     write_notices(&mut md, notices);
@@ -140,7 +147,16 @@ pub fn generate(
     render_core::output::write_atomically(&out.join("table.md"), |tmp| {
         std::fs::write(tmp, &md).map_err(|e| e.to_string())
     })?;
-    super::viewer::write(exp, out, refs_dir, &layout.rows, &layout.cols, &cells, &md)
+    super::viewer::write(
+        exp,
+        out,
+        refs_dir,
+        &layout.rows,
+        &layout.cols,
+        &cells,
+        &md,
+        &mut flips,
+    )
 }
 
 /// cells.csv and cells.json: every finished cell.
@@ -212,6 +228,13 @@ fn write_header(md: &mut String, layout: &Layout, cells: &[CellResult]) {
         report::REF_FLAG,
         report::REF_FLAG_FACTOR,
     );
+    md.push_str(
+        "HDR-ꟻLIP (Andersson et al. 2020, 2021; `nv-flip`'s LDR-ꟻLIP over the exposures from the one that \
+         brings the reference's maximum to 0.85 after tone mapping to the one that brings its median there, \
+         per pixel the largest): the mean per-pixel perceived difference from the reference in [0, 1] \
+         (0: none) for a viewer at 67 pixels per degree, over the same pixels as relMSE. It has no speed-ups: \
+         it is not proportional to the variance. Its maps are in `flip-maps/` and in index.html.\n\n",
+    );
 }
 
 /// The table's code state, as its header names it: one commit, or what else is mixed in.
@@ -281,6 +304,38 @@ fn write_error_tables(md: &mut String, layout: &Layout, cells: &[CellResult], pi
                 report::REF_FLAG_FACTOR
             );
         }
+        md.push('\n');
+    }
+}
+
+/// One HDR-ꟻLIP table per budget (see [`flip_table::format`]), where its cells have ꟻLIP.
+fn write_flip_tables(md: &mut String, layout: &Layout, cells: &[CellResult], pixels: Pixels) {
+    let which = match pixels {
+        Pixels::Unlit => "",
+        Pixels::All => "all pixels, ",
+    };
+    for budget in &layout.budgets {
+        let mut groups: BTreeMap<(String, String), Vec<&CellResult>> = BTreeMap::new();
+        for c in cells.iter().filter(|c| &c.budget == budget) {
+            groups
+                .entry((c.scene.clone(), c.strategy.clone()))
+                .or_default()
+                .push(c);
+        }
+        let g: BTreeMap<(String, String), report::Stat> = groups
+            .into_iter()
+            .filter_map(|(k, v)| Some((k, flip_table::entry(&v, pixels)?)))
+            .collect();
+        if g.is_empty() {
+            continue;
+        }
+        let _ = writeln!(md, "## HDR-ꟻLIP, {which}{}\n", budget.describe());
+        md.push_str(&flip_table::format(
+            &layout.rows,
+            &layout.cols,
+            &g,
+            &layout.marks,
+        ));
         md.push('\n');
     }
 }
@@ -533,6 +588,15 @@ fn strip(
             h,
             &rgb,
         )?;
+        // and its HDR-ꟻLIP map (magma), beside it
+        let flip_maps = out.join("flip-maps");
+        std::fs::create_dir_all(&flip_maps).map_err(|e| e.to_string())?;
+        super::flip::save_map(
+            &flip_maps.join(format!("{}__{}.png", slug(scene), slug(col))),
+            &super::flip::hdr_flip_map(&px, &reference, w, h)?,
+            w,
+            h,
+        )?;
         if col == exp.baseline() || baseline_err.is_none() {
             baseline_err = Some(err.clone());
         }
@@ -669,6 +733,8 @@ mod tests {
                 render: serde_json::json!({ "git_commit": "abc" }),
                 code: None,
                 inputs: None,
+                flip_all: None,
+                flip_unlit: None,
             };
             render_core::output::write_json(
                 &out.join("cells").join(format!("{}.json", r.id)),

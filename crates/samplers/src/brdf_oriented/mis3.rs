@@ -8,7 +8,7 @@ use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
 use super::sg_importance::SgImportance;
 use super::technique::BoState;
-use super::three_techniques::{PointTechniques, Taken};
+use super::three_techniques::{LEARNED_SLOT, LsState, PointTechniques, Taken};
 pub use super::three_techniques::{TECHNIQUE_BO, TECHNIQUE_BSDF, TECHNIQUE_LS};
 use super::{BoConfig, LobePivot};
 use crate::mis::power_heuristic;
@@ -58,6 +58,9 @@ pub struct Mis3<C: CapIntegral> {
     pub n_max_now: AtomicU32,
     /// The N_max of each pass (`efficient_total`), for the render's JSON.
     pub n_max_log: Mutex<NMaxLog>,
+    /// `mis3-adaptive-learned`: the learned cluster selection as the LS technique at every
+    /// point (issue 25), in place of the tree's cut or descent.
+    pub learned: Option<crate::learned::selection::LearnedSelection>,
 }
 
 /// Passes completed and the N_max in force from each change on: `(first pass, N_max)`, the
@@ -127,6 +130,7 @@ impl<C: CapIntegral> Mis3<C> {
             sg_nodes: None,
             n_max_now,
             n_max_log: Mutex::new(NMaxLog::default()),
+            learned: None,
         }
     }
 
@@ -134,6 +138,22 @@ impl<C: CapIntegral> Mis3<C> {
     /// `reproduce`, which `create` turns it off for).
     fn learns_n_max(&self) -> bool {
         self.config.efficient_total && self.config.adaptive_total && self.mode == Mis3Mode::Adaptive
+    }
+
+    /// Heuristic 1's N_max for the next pass from the pass's efficiency tallies.
+    fn learn_n_max(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+        if !self.learns_n_max() {
+            return;
+        }
+        let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
+        log.passes += 1;
+        if let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory) {
+            self.n_max_now.store(n_max.to_bits(), Ordering::Relaxed);
+            if log.changes.last().map(|c| c.1) != Some(n_max) {
+                let next = log.passes + 1;
+                log.changes.push((next, n_max));
+            }
+        }
     }
 
     fn n_max_now(&self) -> f32 {
@@ -171,6 +191,22 @@ where
             let log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
             map.insert("n_max_by_pass".into(), serde_json::json!(log.changes));
         }
+        if let Some(l) = &self.learned
+            && let Some(map) = v.as_object_mut()
+        {
+            let t = l.table.read().unwrap_or_else(|e| e.into_inner());
+            map.insert(
+                "learned".into(),
+                serde_json::json!({
+                    "config": l.config,
+                    "clusters": l.cut.len(),
+                    "cell_size": l.grid.cell,
+                    "regions": t.len(),
+                    "region_memory_bytes": t.memory_bytes(),
+                    "dropped_observations": t.dropped,
+                }),
+            );
+        }
         v
     }
 
@@ -189,6 +225,9 @@ where
     }
 
     fn begin_render(&self) {
+        if let Some(l) = &self.learned {
+            l.table.write().unwrap_or_else(|e| e.into_inner()).clear();
+        }
         self.n_max_now
             .store((self.config.n_max as f32).to_bits(), Ordering::Relaxed);
         let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
@@ -198,18 +237,17 @@ where
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
-        if !self.learns_n_max() {
-            return;
-        }
-        let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
-        log.passes += 1;
-        if let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory) {
-            self.n_max_now.store(n_max.to_bits(), Ordering::Relaxed);
-            if log.changes.last().map(|c| c.1) != Some(n_max) {
-                let next = log.passes + 1;
-                log.changes.push((next, n_max));
-            }
-        }
+        let Some(learned) = &self.learned else {
+            return self.learn_n_max(pixel_memory);
+        };
+        // Both learners read every pixel, in pixel order.
+        let pixels: Vec<&[f32; PIXEL_MEMORY]> = pixel_memory.collect();
+        learned
+            .table
+            .write()
+            .unwrap_or_else(|e| e.into_inner())
+            .merge_pass(&mut pixels.iter().copied(), LEARNED_SLOT);
+        self.learn_n_max(&mut pixels.iter().copied());
     }
 
     fn estimate(
@@ -305,17 +343,19 @@ where
         } else {
             self.bo_state(sp)
         };
-        let ls_state = if bo.is_some() && self.config.single_ls_at_glossy {
-            self.ls.prepare_capped(sp, 1)
+        let ls = if let Some(learned) = &self.learned {
+            let table = learned.table.read().unwrap_or_else(|e| e.into_inner());
+            LsState::Learned(learned, learned.prepare_with(scene, sp, &table))
+        } else if bo.is_some() && self.config.single_ls_at_glossy {
+            LsState::Tree(&self.ls, self.ls.prepare_capped(sp, 1))
         } else {
-            self.ls.prepare(scene, sp)
+            LsState::Tree(&self.ls, self.ls.prepare(scene, sp))
         };
         PointTechniques {
             scene,
             sp,
             tree,
-            ls: &self.ls,
-            ls_state,
+            ls,
             bo,
             fresh: !self.config.reproduce,
         }

@@ -4,6 +4,8 @@
 use super::importance::LobeDensity;
 use super::technique::BoState;
 use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
+use crate::learned::regions::Observation;
+use crate::learned::selection::{LearnedSelection, LearnedState};
 use crate::light_strategy::sample_pick;
 use crate::selection::LightSelection;
 use crate::tree_selection::{TreeSelection, TreeState};
@@ -44,10 +46,8 @@ pub struct PointTechniques<'a, L> {
     pub sp: &'a ShadingPoint,
     /// The light tree both cuts are of.
     pub tree: &'a LightTree,
-    /// The LS technique.
-    pub ls: &'a TreeSelection,
-    /// The LS cut of this point.
-    pub ls_state: TreeState,
+    /// The LS technique and its state at this point.
+    pub ls: LsState<'a>,
     /// The BO state, at glossy points.
     pub bo: Option<BoState<'a, L>>,
     /// BO's descent takes a fresh random number per tree level (off: the authors' rescaled one).
@@ -77,7 +77,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
             } else {
                 l.pdf(sp.point(), point, normal)
             };
-            self.ls.pmf(&self.ls_state, sp, light as u32) * p_pt
+            self.ls.pmf(sp, light as u32) * p_pt
         };
         let p_bo = match &self.bo {
             Some(b) if own != TECHNIQUE_BO || cfg!(debug_assertions) => {
@@ -102,10 +102,16 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
         ctx: &mut SampleContext,
     ) {
         let (scene, sp) = (self.scene, self.sp);
-        self.ls.pick(&self.ls_state, sp, rng, picks);
+        self.ls.pick(sp, rng, picks);
         for &(light, pmf) in picks.iter() {
             ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
-            let Some((s, p_ls, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters) else {
+            let sampled = match &self.ls {
+                LsState::Learned(sel, st) => {
+                    sample_observed(scene, sp, light, pmf, rng, ctx, sel, st)
+                }
+                LsState::Tree(..) => sample_pick(scene, sp, light, pmf, rng, ctx.counters),
+            };
+            let Some((s, p_ls, f)) = sampled else {
                 continue;
             };
             let mut p = self.densities(
@@ -118,7 +124,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
             );
             debug_assert!(
                 {
-                    let replay = self.ls.pmf(&self.ls_state, sp, light)
+                    let replay = self.ls.pmf(sp, light)
                         * scene.lights[light as usize].pdf(sp.point(), s.point, s.normal);
                     s.is_delta || (replay - p_ls).abs() <= 1e-3 * p_ls
                 },
@@ -222,8 +228,83 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
     /// Clusters of the LS cut and of the BO cut (0 without BO).
     pub fn cluster_counts(&self) -> (usize, usize) {
         (
-            self.ls.clusters(&self.ls_state),
+            self.ls.clusters(),
             self.bo.as_ref().map_or(0, |b| b.cut().cut.len()),
         )
     }
+}
+
+/// The LS technique of one point: the light tree (E&K cut or one descent) or, in
+/// `mis3-adaptive-learned`, the learned cluster selection (issue 25).
+pub enum LsState<'a> {
+    /// The tree and its cut at this point.
+    Tree(&'a TreeSelection, TreeState),
+    /// The learned selection and its cluster probabilities at this point.
+    Learned(&'a LearnedSelection, LearnedState),
+}
+
+/// First pixel-memory slot of the learned LS's observation (after the method's own slots).
+pub const LEARNED_SLOT: usize = 10;
+const _: () =
+    assert!(LEARNED_SLOT + crate::learned::regions::SLOTS <= render_core::estimator::PIXEL_MEMORY);
+
+impl LsState<'_> {
+    fn pick(&self, sp: &ShadingPoint, rng: &mut SampleStream, picks: &mut Vec<(u32, f32)>) {
+        match self {
+            LsState::Tree(s, st) => s.pick(st, sp, rng, picks),
+            LsState::Learned(s, st) => s.pick(st, sp, rng, picks),
+        }
+    }
+
+    /// The LS probability of choosing `light`.
+    pub fn pmf(&self, sp: &ShadingPoint, light: u32) -> f32 {
+        match self {
+            LsState::Tree(s, st) => s.pmf(st, sp, light),
+            LsState::Learned(s, st) => s.pmf(st, sp, light),
+        }
+    }
+
+    fn clusters(&self) -> usize {
+        match self {
+            LsState::Tree(s, st) => s.clusters(st),
+            LsState::Learned(s, st) => s.clusters(st),
+        }
+    }
+}
+
+/// [`sample_pick`] for the learned LS: the same draws and value, and the shadow ray's outcome
+/// left in the pixel's memory for the merge after the pass.
+#[allow(clippy::too_many_arguments)]
+fn sample_observed(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    light: u32,
+    pmf: f32,
+    rng: &mut SampleStream,
+    ctx: &mut SampleContext,
+    sel: &LearnedSelection,
+    st: &LearnedState,
+) -> Option<(render_core::light::LightSample, f32, Vec3)> {
+    let u = rng.next_2d();
+    let s = scene.sample_light(light, sp.point(), u)?;
+    let p = pmf * s.pdf;
+    if !(p > 0.0) {
+        return None;
+    }
+    let f = sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance;
+    if f == Vec3::ZERO {
+        return None;
+    }
+    ctx.counters.shadow_rays += 1;
+    let o = sp.origin_towards(s.wi);
+    let hit = !scene.occluded(o, s.wi, (s.point - o).length());
+    if let Some(cluster) = sel.cluster_of(light) {
+        Observation {
+            key: st.key,
+            cluster,
+            hit,
+        }
+        .write(&mut ctx.pixel_memory[LEARNED_SLOT..], st.stamp);
+    }
+    hit.then_some((s, p, f))
 }

@@ -273,6 +273,7 @@ pub fn render_film(
         sampler,
         filter,
         reconstruction,
+        emission_rays: Default::default(),
     };
     render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
 }

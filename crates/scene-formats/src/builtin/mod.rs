@@ -14,6 +14,7 @@ mod glossy_spheres;
 mod grid;
 mod lamp;
 pub mod mesh;
+mod rooms;
 mod staircase;
 mod statue;
 
@@ -190,6 +191,20 @@ const SCENES: &[Def] = &[
             key("seed", "0", SEED_HELP),
         ],
         build: grid::build,
+    },
+    Def {
+        name: "rooms",
+        description: "six rooms off a corridor with a few thousand small lights spread over all of them; the camera looks through a door, so most lights are occluded from most points",
+        keys: &[
+            key(
+                "lights",
+                "3000",
+                "number of lights (sphere lights and emissive triangles, about 60/40)",
+            ),
+            key("roughness", "0.15", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: rooms::build,
     },
 ];
 

@@ -210,6 +210,7 @@ fn names_are_unique_and_documented() {
         "staircase",
         "grid",
         "emissive-mesh",
+        "rooms",
     ] {
         assert!(infos.iter().any(|i| i.name == required), "{required}");
     }
@@ -410,6 +411,7 @@ fn every_builtin_renders_a_lit_image() {
             sampler: Default::default(),
             filter: Default::default(),
             reconstruction: Default::default(),
+            emission_rays: Default::default(),
         };
         let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
         // Leave out pixels that see a light directly: the rest is reflected light.
@@ -433,4 +435,32 @@ fn every_builtin_renders_a_lit_image() {
             info.name
         );
     }
+}
+
+#[test]
+fn rooms_hide_most_lights_from_the_camera() {
+    let s = load_builtin("builtin:rooms").unwrap();
+    assert_eq!(lights_of(&s), 3000);
+    // Both kinds of light, the triangles one-sided and facing down.
+    assert!(s.stats.sphere_lights > 1200 && s.stats.triangle_lights > 800);
+    let eye = s.camera(None).unwrap().position;
+    let mut visible = 0;
+    for l in &s.lights {
+        let (target, shorten) = match l.shape {
+            LightShape::Sphere { center, radius } => (center, radius + 1e-3),
+            LightShape::Triangle { p, normal, .. } => {
+                assert!((normal - Vec3::NEG_Y).length() < 1e-5 && !l.two_sided);
+                ((p[0] + p[1] + p[2]) / 3.0, 1e-3)
+            }
+            LightShape::Point { position } => (position, 0.0),
+        };
+        let d = target - eye;
+        assert!(d.length() > 0.8, "a light right in front of the camera");
+        if !s.occluded(eye, d.normalize(), d.length() - shorten) {
+            visible += 1;
+        }
+    }
+    // Walls decide: most lights are hidden from the camera, some are seen.
+    let share = visible as f32 / 3000.0;
+    assert!(share > 0.05 && share < 0.35, "visible share {share}");
 }

@@ -10,6 +10,7 @@ pub mod encode;
 pub mod markdown;
 
 use super::config::Experiment;
+use super::flip_cells;
 use super::plan::{Budget, slug};
 use super::report::CellResult;
 use glam::Vec3;
@@ -40,6 +41,17 @@ fn unlit_uri(unlit: &[bool], w: u32, h: u32) -> Result<String, String> {
     Ok(encode::data_uri(&encode::png_bytes(&buf, w, h, 1)?))
 }
 
+/// A ꟻLIP map (magma PNG bytes) as the page's data URI: its palette indices as a grey PNG,
+/// a third of the magma PNG's size (the page applies `flip_palette`).
+fn flip_map_uri(png: &[u8], w: u32, h: u32) -> Option<String> {
+    let img = image::load_from_memory(png).ok()?.to_rgb8();
+    if img.dimensions() != (w, h) {
+        return None;
+    }
+    let idx = super::flip::magma_indices(img.as_raw())?;
+    Some(encode::data_uri(&encode::png_bytes(&idx, w, h, 1).ok()?))
+}
+
 /// The render of `cell` (and its own light mask) when renders/ has it at the cell's size.
 fn cell_render(out: &Path, cell: &CellResult) -> Option<(Vec<Vec3>, Option<Vec<bool>>)> {
     let renders = out.join("renders");
@@ -62,6 +74,7 @@ fn scene_data(
     scene: &str,
     cols: &[String],
     cells: &[CellResult],
+    flips: &mut flip_cells::Sources,
 ) -> Result<Value, String> {
     let seed = exp.seeds.first().copied().unwrap_or(0);
     let mine: Vec<&CellResult> = cells
@@ -112,12 +125,22 @@ fn scene_data(
                 ),
                 None => (Value::Null, Value::Null),
             };
+            // the harness's HDR-ꟻLIP map of this render (ꟻLIP is not computed in the page)
+            let flip_map = match image {
+                Value::Null => Value::Null,
+                _ => flips
+                    .map_png(c)
+                    .and_then(|b| flip_map_uri(&b, w, h))
+                    .map_or(Value::Null, Value::String),
+            };
             items.push(json!({
                 "strategy": col,
                 "budget": label,
                 "id": c.id,
                 "seed": c.seed,
                 "rel_mse": c.unlit.rel_mse,
+                "flip": c.flip_unlit,
+                "flip_map": flip_map,
                 "spp": c.spp,
                 "seconds": c.seconds(exp.budget_clock),
                 "image": image,
@@ -125,15 +148,18 @@ fn scene_data(
             }));
         }
     }
-    let error_maps: Vec<Value> = cols
-        .iter()
-        .filter_map(|col| {
-            let src = format!("error-maps/{}__{}.png", slug(scene), slug(col));
-            out.join(&src)
-                .is_file()
-                .then(|| json!({ "strategy": col, "src": src }))
-        })
-        .collect();
+    let maps_in = |dir: &str| -> Vec<Value> {
+        cols.iter()
+            .filter_map(|col| {
+                let src = format!("{dir}/{}__{}.png", slug(scene), slug(col));
+                out.join(&src)
+                    .is_file()
+                    .then(|| json!({ "strategy": col, "src": src }))
+            })
+            .collect()
+    };
+    let error_maps = maps_in("error-maps");
+    let flip_maps = maps_in("flip-maps");
     let strip_budget = exp
         .spp
         .iter()
@@ -158,12 +184,15 @@ fn scene_data(
         "reference": reference,
         "cells": items,
         "error_maps": error_maps,
+        "flip_maps": flip_maps,
+        "flip_palette": super::flip::magma_palette(),
         "error_maps_budget": format!("{strip_budget}, seed {seed}"),
     }))
 }
 
 /// Writes `out/index.html` and `out/viewer/<scene>.js` for the scenes `rows` and the strategy
-/// columns `cols`; `md` is table.md, shown below the viewer.
+/// columns `cols`; `md` is table.md, shown below the viewer; `flips` gives the cells' ꟻLIP maps.
+#[allow(clippy::too_many_arguments)]
 pub fn write(
     exp: &Experiment,
     out: &Path,
@@ -172,12 +201,13 @@ pub fn write(
     cols: &[String],
     cells: &[CellResult],
     md: &str,
+    flips: &mut flip_cells::Sources,
 ) -> Result<(), String> {
     let dir = out.join("viewer");
     std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     let mut scripts = Vec::new();
     for scene in rows {
-        let data = scene_data(exp, out, refs_dir, scene, cols, cells)?;
+        let data = scene_data(exp, out, refs_dir, scene, cols, cells, flips)?;
         let file = format!("{}.js", slug(scene));
         // `</` cannot end a script that is a file of its own, but keep the data inert anyway
         let text = format!(
@@ -228,10 +258,12 @@ fn page(exp: &Experiment, scripts: &[String], md: &str) -> String {
          <div id=\"split\"></div><span class=\"tag\" id=\"tagA\"></span><span class=\"tag\" id=\"tagB\"></span></div>\n\
          <p id=\"info\"></p>\n\
          <p class=\"keys\">Wheel: zoom at the cursor; drag: pan; double-click or f: fit. 0–9: A, shift+0–9: B; \
-         space: flip A/B; s: swipe (the split follows the mouse); e: error map; −/+: exposure. \
-         Error maps: per-pixel relMSE (x − r)² / (r² + 0.01), log scale 1e-4<span id=\"legend\"></span>10, \
-         grey where the camera sees a light.</p>\n\
-         <h3 id=\"mapsTitle\"></h3>\n<div id=\"maps\"></div>\n</section>\n",
+         space: flip A/B; s: swipe (the split follows the mouse); e: relMSE map; l: ꟻLIP map; −/+: exposure. \
+         relMSE maps: per-pixel (x − r)² / (r² + 0.01), log scale 1e-4<span id=\"legend\"></span>10, \
+         grey where the camera sees a light. ꟻLIP maps: the harness's per-pixel HDR-ꟻLIP from the full-precision \
+         render, magma 0 (black) to 1 (yellow-white), every pixel.</p>\n\
+         <h3 id=\"mapsTitle\"></h3>\n<div id=\"maps\"></div>\n\
+         <h3 id=\"flipMapsTitle\"></h3>\n<div id=\"flipMaps\"></div>\n</section>\n",
     );
     h.push_str("<section id=\"tables\">\n");
     // table.md's own title is the page's

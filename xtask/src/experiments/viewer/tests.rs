@@ -190,6 +190,8 @@ fn report_page_is_well_formed_and_complete() {
             render: serde_json::json!({ "git_commit": "abc" }),
             code: None,
             inputs: None,
+            flip_all: None,
+            flip_unlit: None,
         };
         render_core::output::write_json(
             &out.join("cells").join(format!("{}.json", r.id)),
@@ -205,6 +207,15 @@ fn report_page_is_well_formed_and_complete() {
                 w,
                 h,
                 &px,
+            )
+            .unwrap();
+            // the ꟻLIP map measure() keeps beside a render
+            let map: Vec<f32> = (0..n).map(|i| i as f32 / n as f32).collect();
+            crate::experiments::flip::save_map(
+                &out.join("renders").join(format!("{}.flip.png", r.id)),
+                &map,
+                w,
+                h,
             )
             .unwrap();
             rendered.push((r.id.clone(), px));
@@ -266,6 +277,20 @@ fn report_page_is_well_formed_and_complete() {
             .iter()
             .find(|(id, _)| c["id"] == id.as_str())
             .unwrap();
+        // its ꟻLIP map, as the harness wrote it: palette indices that colour to the magma PNG
+        let f = png_of(c["flip_map"].as_str().unwrap()).to_luma8();
+        assert_eq!(f.dimensions(), (w, h));
+        let pal: Vec<u8> = serde_json::from_value(data["flip_palette"].clone()).unwrap();
+        let coloured: Vec<u8> = f
+            .as_raw()
+            .iter()
+            .flat_map(|&i| pal[3 * i as usize..3 * i as usize + 3].to_vec())
+            .collect();
+        let path = out
+            .join("renders")
+            .join(format!("{}.flip.png", c["id"].as_str().unwrap()));
+        let magma = image::open(path).unwrap().to_rgb8().into_raw();
+        assert_eq!(coloured, magma);
         let img = png_of(c["image"].as_str().unwrap()).to_rgb8();
         assert_eq!(img.dimensions(), (w, 2 * h));
         let back = encode::decode_split(&img.into_raw(), w, h);
@@ -292,12 +317,23 @@ fn report_page_is_well_formed_and_complete() {
     for m in maps {
         assert!(out.join(m["src"].as_str().unwrap()).is_file());
     }
+    // and its HDR-ꟻLIP maps beside them
+    let maps = data["flip_maps"].as_array().unwrap();
+    assert_eq!(maps.len(), 2);
+    for m in maps {
+        let src = m["src"].as_str().unwrap();
+        assert!(
+            src.starts_with("flip-maps/") && out.join(src).is_file(),
+            "{src}"
+        );
+    }
 
     // "t": no reference and no renders on this machine, still listed, images null
     let js = std::fs::read_to_string(out.join("viewer/t.js")).unwrap();
     assert!(js.contains("\"reference\":null"), "{js}");
     assert!(!js.contains("data:image"), "{js}");
     assert!(js.contains("\"image\":null"));
+    assert!(js.contains("\"flip_map\":null") && js.contains("\"flip_maps\":[]"));
     let _ = Budget::Spp(0);
     let _ = std::fs::remove_dir_all(&base);
 }
@@ -322,6 +358,7 @@ fn stale_scene_data_is_removed() {
         &[],
         &[],
         "# x\n",
+        &mut crate::experiments::flip_cells::Sources::new(&dir, Path::new("/nonexistent")),
     )
     .unwrap();
     assert!(!dir.join("viewer/old.js").exists());

@@ -1,0 +1,225 @@
+//! The learned cluster selection at one shading point: a cluster of the fixed cut by the
+//! posterior weight w_c = prior_c · V̂_c mixed with the prior alone, then the tree's descent
+//! inside the cluster. `pick` and `pmf` read the same per-point probabilities, so a light's
+//! probability at sampling and at any replay is the same number.
+use super::LearnedConfig;
+use super::regions::{RegionGrid, RegionTable};
+use crate::selection::LightSelection;
+use crate::tree_selection::{PowerUnits, TreeMode, TreeSelection, TreeState};
+use light_tree::{Cut, LightTree, Rescaled};
+use render_core::estimator::ShadingPoint;
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+use std::sync::RwLock;
+
+/// Most clusters a fixed cut may have (the per-point probabilities live on the stack).
+pub const MAX_CLUSTERS: usize = 256;
+
+/// Learned cluster selection over a fixed cut of the light tree.
+pub struct LearnedSelection {
+    /// The light tree, used by single descent for its memoised node importances.
+    pub tree: TreeSelection,
+    /// The fixed cut (breadth-first from the root to `config.clusters` nodes), built once.
+    pub cut: Cut,
+    /// Shading point → region.
+    pub grid: RegionGrid,
+    /// Its parameters.
+    pub config: LearnedConfig,
+    /// What earlier passes taught, frozen during a pass.
+    pub table: RwLock<RegionTable>,
+}
+
+impl LearnedSelection {
+    /// The selection for `scene` (tree in `units` of power).
+    pub fn new(
+        scene: &Scene,
+        units: PowerUnits,
+        config: LearnedConfig,
+    ) -> Result<LearnedSelection, String> {
+        if !(1..=MAX_CLUSTERS).contains(&config.clusters) {
+            return Err(format!(
+                "learned selection: clusters must be in 1..={MAX_CLUSTERS}, got {}",
+                config.clusters
+            ));
+        }
+        if !(config.defensive > 0.0 && config.defensive <= 1.0) || !(config.prior_strength > 0.0) {
+            return Err(format!(
+                "learned selection: need defensive share in (0, 1] and prior strength > 0, got {} and {}",
+                config.defensive, config.prior_strength
+            ));
+        }
+        let tree = TreeSelection::new(scene, TreeMode::Single, units)?;
+        // Breadth-first: clusters of about equal depth, which the SAOH build keeps compact
+        // in space (a room's lights, a lamp's bulbs), the unit visibility is learnt for.
+        let cut = tree
+            .tree
+            .as_ref()
+            .map_or_else(Cut::default, |t| t.cut(config.clusters, |_| true));
+        let (lo, _) = scene.bounds;
+        let grid = RegionGrid::new(lo, scene.diagonal(), config.cells_per_diagonal);
+        Ok(LearnedSelection {
+            tree,
+            table: RwLock::new(RegionTable::new(cut.len(), config.max_regions)),
+            cut,
+            grid,
+            config,
+        })
+    }
+
+    fn light_tree(&self) -> Option<&LightTree> {
+        self.tree.tree.as_ref()
+    }
+}
+
+/// One shading point: its region, the memoised importances and the cluster probabilities.
+pub struct LearnedState {
+    tree: TreeState,
+    /// The region of the shading point.
+    pub key: u64,
+    /// The stamp of the pass being drawn (the passes merged into the table + 1).
+    pub stamp: u32,
+    /// Unnormalised probability of each cluster; `total` is their sum.
+    q: [f32; MAX_CLUSTERS],
+    total: f64,
+}
+
+impl LearnedState {
+    /// Probability of choosing cluster `c`.
+    pub fn cluster_pmf(&self, c: usize) -> f32 {
+        if self.total > 0.0 {
+            (self.q[c] as f64 / self.total) as f32
+        } else {
+            0.0
+        }
+    }
+}
+
+#[inline]
+fn sanitize(x: f32) -> f32 {
+    if x.is_finite() && x > 0.0 { x } else { 0.0 }
+}
+
+impl LearnedSelection {
+    /// The selection's state at `sp` with the statistics in `table`.
+    pub fn prepare_with(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        table: &RegionTable,
+    ) -> LearnedState {
+        let tree = self.tree.prepare(scene, sp);
+        let key = self.grid.key(sp.point(), sp.bsdf.ng);
+        let mut state = LearnedState {
+            tree,
+            key,
+            stamp: table.pass + 1,
+            q: [0.0; MAX_CLUSTERS],
+            total: 0.0,
+        };
+        let Some(lt) = self.light_tree() else {
+            return state;
+        };
+        let k = self.cut.len();
+        let region = table.region(key);
+        let a = self.config.prior_strength;
+        let (mut sum_prior, mut sum_w) = (0.0f64, 0.0f64);
+        let mut w = [0.0f32; MAX_CLUSTERS];
+        for c in 0..k {
+            let prior = sanitize(state.tree.importance(lt, self.cut.nodes[c]));
+            state.q[c] = prior;
+            // V̂ = (hits + a)/(rays + a): 1 before any ray, the hit rate after many.
+            let v = region.map_or(1.0, |r| (r[c].hits as f32 + a) / (r[c].rays as f32 + a));
+            w[c] = prior * v;
+            sum_prior += prior as f64;
+            sum_w += w[c] as f64;
+        }
+        if !(sum_prior > 0.0) {
+            state.q[..k].iter_mut().for_each(|q| *q = 0.0);
+            return state;
+        }
+        let alpha = self.config.defensive as f64;
+        let mut total = 0.0f64;
+        for c in 0..k {
+            let learned = if sum_w > 0.0 {
+                w[c] as f64 / sum_w
+            } else {
+                0.0
+            };
+            let q = (1.0 - alpha) * learned + alpha * state.q[c] as f64 / sum_prior;
+            state.q[c] = q as f32;
+            total += state.q[c] as f64;
+        }
+        state.total = total;
+        state
+    }
+
+    /// Chooses a cluster from 64 random bits: (cluster, its probability).
+    pub fn pick_cluster(&self, state: &LearnedState, bits: u64) -> Option<(usize, f32)> {
+        if !(state.total > 0.0) {
+            return None;
+        }
+        let t = (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64) * state.total;
+        let k = self.cut.len();
+        let mut cum = 0.0f64;
+        let mut last = None;
+        for c in 0..k {
+            let q = state.q[c];
+            if q > 0.0 {
+                cum += q as f64;
+                last = Some(c);
+                if t < cum {
+                    break;
+                }
+            }
+        }
+        last.map(|c| (c, state.cluster_pmf(c)))
+    }
+
+    /// The cluster (index into the cut) holding `light`.
+    pub fn cluster_of(&self, light: u32) -> Option<usize> {
+        self.cut.cluster_of(self.light_tree()?, light as usize)
+    }
+}
+
+impl LightSelection for LearnedSelection {
+    type State = LearnedState;
+
+    fn prepare(&self, scene: &Scene, sp: &ShadingPoint) -> LearnedState {
+        let table = self.table.read().unwrap_or_else(|e| e.into_inner());
+        self.prepare_with(scene, sp, &table)
+    }
+
+    fn pick(
+        &self,
+        state: &LearnedState,
+        _: &ShadingPoint,
+        rng: &mut SampleStream,
+        picks: &mut Vec<(u32, f32)>,
+    ) {
+        let Some(lt) = self.light_tree() else { return };
+        let cluster = self.pick_cluster(state, rng.next_u64());
+        // The descent's number is drawn whether or not a cluster was, so later draws keep
+        // their dimensions.
+        let mut u = Rescaled(rng.next_u64());
+        let Some((c, pc)) = cluster else { return };
+        let imp = |id| state.tree.importance(lt, id);
+        if let Some((light, p)) = lt.sample_subtree(self.cut.nodes[c], imp, &mut u) {
+            picks.push((light as u32, pc * p));
+        }
+    }
+
+    fn pmf(&self, state: &LearnedState, _: &ShadingPoint, light: u32) -> f32 {
+        let Some(lt) = self.light_tree() else {
+            return 0.0;
+        };
+        let Some(c) = self.cluster_of(light) else {
+            return 0.0;
+        };
+        let pc = state.cluster_pmf(c);
+        if !(pc > 0.0) {
+            return 0.0;
+        }
+        let imp = |id| state.tree.importance(lt, id);
+        pc * lt.pmf_subtree(self.cut.nodes[c], imp, light as usize)
+    }
+}

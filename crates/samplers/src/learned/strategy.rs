@@ -1,0 +1,135 @@
+//! Strategies `learned` and `learned+bsdf`: one light by the learned cluster selection (±
+//! one BSDF sample, power heuristic), each light sample leaving its visibility in the
+//! pixel's memory for the merge between passes.
+use super::regions::Observation;
+use super::selection::LearnedSelection;
+use crate::bsdf_sampling::sample_bsdf;
+use crate::light_strategy::{Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
+use crate::mis::power2;
+use crate::scratch::Pooled;
+use crate::selection::LightSelection;
+use render_core::Vec3;
+use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+
+/// The learned selection as a strategy.
+pub struct LearnedStrategy {
+    /// `learned` or `learned+bsdf`.
+    pub name: String,
+    /// The selection and its statistics.
+    pub selection: LearnedSelection,
+    /// Add one BSDF sample, combined by the power heuristic.
+    pub with_bsdf: bool,
+}
+
+impl DirectLighting for LearnedStrategy {
+    fn name(&self) -> String {
+        self.name.clone()
+    }
+
+    fn parameters(&self) -> serde_json::Value {
+        let t = self
+            .selection
+            .table
+            .read()
+            .unwrap_or_else(|e| e.into_inner());
+        serde_json::json!({
+            "config": self.selection.config,
+            "clusters": self.selection.cut.len(),
+            "cell_size": self.selection.grid.cell,
+            "regions": t.len(),
+            "region_memory_bytes": t.memory_bytes(),
+            "dropped_observations": t.dropped,
+            "passes_learnt": t.pass,
+        })
+    }
+
+    fn techniques(&self) -> Vec<&'static str> {
+        if self.with_bsdf {
+            vec!["light", "bsdf"]
+        } else {
+            vec!["light"]
+        }
+    }
+
+    fn estimate(
+        &self,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        rng: &mut SampleStream,
+        ctx: &mut SampleContext,
+    ) -> Vec3 {
+        let sel = &self.selection;
+        let state = {
+            let table = sel.table.read().unwrap_or_else(|e| e.into_inner());
+            sel.prepare_with(scene, sp, &table)
+        };
+        let stamp = state.stamp;
+        Observation::clear(&mut ctx.pixel_memory[..]);
+        ctx.counters
+            .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
+        let mut picks = Pooled::<Picks>::take();
+        sel.pick(&state, sp, rng, &mut picks.0);
+        let x = sp.point();
+        let mut l = Vec3::ZERO;
+        // The point on the light is drawn even without a pick, so later draws keep their
+        // dimensions.
+        let u = rng.next_2d();
+        ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
+        if let Some(&(light, pmf)) = picks.0.first()
+            && let Some(s) = scene.sample_light(light, x, u)
+            && pmf * s.pdf > 0.0
+        {
+            let p = pmf * s.pdf;
+            let f = sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance;
+            if f != Vec3::ZERO {
+                ctx.counters.shadow_rays += 1;
+                let o = sp.origin_towards(s.wi);
+                let hit = !scene.occluded(o, s.wi, (s.point - o).length());
+                if let Some(cluster) = sel.cluster_of(light) {
+                    record(&mut ctx.pixel_memory[..], state.key, cluster, hit, stamp);
+                }
+                if hit {
+                    let w = if self.with_bsdf && !s.is_delta {
+                        power2(p, sp.bsdf.pdf(sp.wo, s.wi))
+                    } else {
+                        1.0
+                    };
+                    l += f * (w / p);
+                }
+            }
+        }
+        if self.with_bsdf {
+            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
+            if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)
+                && b.found_light()
+            {
+                let p_light = sel.pmf(&state, sp, b.light)
+                    * scene.lights[b.light as usize].pdf(x, b.point, b.normal);
+                l += b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf);
+            }
+        }
+        l
+    }
+
+    fn begin_render(&self) {
+        self.selection
+            .table
+            .write()
+            .unwrap_or_else(|e| e.into_inner())
+            .clear();
+    }
+
+    fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+        self.selection
+            .table
+            .write()
+            .unwrap_or_else(|e| e.into_inner())
+            .merge_pass(pixel_memory, 0);
+    }
+}
+
+fn record(memory: &mut [f32], key: u64, cluster: usize, hit: bool, stamp: u32) {
+    Observation { key, cluster, hit }.write(memory, stamp);
+}
