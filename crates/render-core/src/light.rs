@@ -161,7 +161,9 @@ impl TrianglePoint {
         let dist2 = d.length_squared();
         let dist = dist2.sqrt();
         let wi = d / dist;
-        let cos_l = normal.dot(-wi);
+        // The same operations as `Light::pdf`, so that a replayed density is bit-identical even
+        // at grazing angles, where cos_l is the difference of nearly equal products.
+        let cos_l = normal.dot(-d) / dist;
         if dist2 <= 0.0 || cos_l.abs() <= 0.0 {
             return None;
         }
