@@ -19,6 +19,7 @@
 use crate::lanes::{Fast, Lanes};
 use crate::{BuildError, FLAG_HALF_SPACE, FLAG_TWO_SIDED, LightTree, Node, NodeExtra};
 use glam::Vec3;
+use rayon::prelude::*;
 
 /// Set in [`NodePair::child`] for a leaf: the low bits are then its light.
 pub(crate) const LEAF_BIT: u32 = 1 << 31;
@@ -235,9 +236,13 @@ impl Compact {
             Some(light) => LEAF_BIT | light as u32,
             None => pair_of[id],
         };
+        let slots: Vec<Slot> = (0..nodes.len())
+            .into_par_iter()
+            .map(|i| slot(&quant, &nodes[i], &extra[i]))
+            .collect();
         let mut pairs = vec![NodePair::default(); count as usize];
         let mut slot_of = vec![0u32; nodes.len()];
-        pairs[0].set(0, &slot(&quant, &nodes[0], &extra[0]), child_code(0));
+        pairs[0].set(0, &slots[0], child_code(0));
         // The empty right slot: zero power, so its importance is 0 (a valid axis keeps NaN
         // out of its lane).
         pairs[0].child[1] = LEAF_BIT;
@@ -246,7 +251,7 @@ impl Compact {
             if let Some((l, r)) = node.children(id as u32) {
                 let p = pair_of[id];
                 for (side, c) in [(0, l as usize), (1, r as usize)] {
-                    pairs[p as usize].set(side, &slot(&quant, &nodes[c], &extra[c]), child_code(c));
+                    pairs[p as usize].set(side, &slots[c], child_code(c));
                     slot_of[c] = 2 * p + side as u32;
                 }
             }
@@ -259,19 +264,36 @@ impl Compact {
     }
 }
 
-/// The compact E&K importances `[left, right]` of a pair for a receiver at `x` with normal `n`
-/// (`Vec3::ZERO`: no receiver term): the exact importance's formula, term for term, on the
-/// decoded bounds, with selects instead of early exits.
+/// The compact E&K importances `[left, right]` of pair `p` for a receiver at `x` with normal
+/// `n` (`Vec3::ZERO`: no receiver term).
 #[inline(always)]
 pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec3) -> [f32; 2] {
-    let code = |c: [u16; 2]| L::pair(c[0] as f32, c[1] as f32);
+    let v = quad_importance::<L>(p, p, q, x, n);
+    [v[0], v[1]]
+}
+
+/// The compact importances of two pairs at once, `[a.left, a.right, b.left, b.right]`: the
+/// exact importance's formula, term for term, on the decoded bounds, with selects instead of
+/// early exits. Each lane only sees its own node, so a node's value is the same bits in either
+/// pair position and in [`pair_importance`].
+#[inline(always)]
+pub(crate) fn quad_importance<L: Lanes>(
+    a: &NodePair,
+    b: &NodePair,
+    q: &Quant,
+    x: Vec3,
+    n: Vec3,
+) -> [f32; 4] {
+    let code = |ca: [u16; 2], cb: [u16; 2]| {
+        L::quad(ca[0] as f32, ca[1] as f32, cb[0] as f32, cb[1] as f32)
+    };
     let half_l = L::splat(0.5);
     let mut c = [L::splat(0.0); 3];
     let mut h = [L::splat(0.0); 3];
     for k in 0..3 {
         let (o, s) = (L::splat(q.origin[k]), L::splat(q.step[k]));
-        let lo = o + code(p.qbox[k]) * s;
-        let hi = o + code(p.qbox[k + 3]) * s;
+        let lo = o + code(a.qbox[k], b.qbox[k]) * s;
+        let hi = o + code(a.qbox[k + 3], b.qbox[k + 3]) * s;
         c[k] = (lo + hi) * half_l - L::splat(x[k]);
         h[k] = (hi - lo) * half_l;
     }
@@ -279,7 +301,26 @@ pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec
     let zero = L::splat(0.0);
     let one = L::splat(1.0);
 
-    let ax = [0, 1, 2].map(|k| L::pair(p.axis[k][0] as f32, p.axis[k][1] as f32));
+    let ax = [0, 1, 2].map(|k| {
+        let (u, v) = (a.axis[k], b.axis[k]);
+        L::quad(u[0] as f32, u[1] as f32, v[0] as f32, v[1] as f32)
+    });
+    let flag = |f: u8| {
+        L::mask([
+            a.flags[0] & f != 0,
+            a.flags[1] & f != 0,
+            b.flags[0] & f != 0,
+            b.flags[1] & f != 0,
+        ])
+    };
+    let cosines = |u: [i16; 2], v: [i16; 2]| {
+        L::quad(
+            decode_cos(u[0]),
+            decode_cos(u[1]),
+            decode_cos(v[0]),
+            decode_cos(v[1]),
+        )
+    };
     let inv_len = one / dot3(&ax, &ax).sqrt();
     let ax = ax.map(|v| v * inv_len);
 
@@ -295,10 +336,7 @@ pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec
         ];
         dark = (dot3(&nv, &c) + dot3(&na, &h)).le(zero);
     }
-    let half_space = L::mask(
-        p.flags[0] & FLAG_HALF_SPACE != 0,
-        p.flags[1] & FLAG_HALF_SPACE != 0,
-    );
+    let half_space = flag(FLAG_HALF_SPACE);
     let behind = (dot3(&ax, &c.map(|v| zero - v)) + dot3(&ax.map(L::abs), &h)).le(zero);
     dark = dark.or(half_space.and(behind));
 
@@ -313,14 +351,11 @@ pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec
 
     // Emitter: θ between the axis and x − c.
     let mut cos_t = zero - dot3(&ax, &w);
-    let two_sided = L::mask(
-        p.flags[0] & FLAG_TWO_SIDED != 0,
-        p.flags[1] & FLAG_TWO_SIDED != 0,
-    );
+    let two_sided = flag(FLAG_TWO_SIDED);
     cos_t = L::select(two_sided, cos_t.abs(), cos_t);
     let sin_t = (one - cos_t * cos_t).max(zero).sqrt();
-    let cos_o = L::pair(decode_cos(p.cos_o[0]), decode_cos(p.cos_o[1]));
-    let cos_e = L::pair(decode_cos(p.cos_e[0]), decode_cos(p.cos_e[1]));
+    let cos_o = cosines(a.cos_o, b.cos_o);
+    let cos_e = cosines(a.cos_e, b.cos_e);
     let sin_o = (one - cos_o * cos_o).max(zero).sqrt();
     let within = cos_t.ge(cos_o);
     let cos_x = L::select(within, one, cos_t * cos_o + sin_t * sin_o);
@@ -340,10 +375,10 @@ pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec
         one
     };
 
-    let power = L::pair(p.power[0], p.power[1]);
+    let power = L::quad(a.power[0], a.power[1], b.power[0], b.power[1]);
     let outside = power * emit * recv / d2c;
     let value = L::select(inside, power / d2c, cone_dark.andnot(outside));
-    dark.andnot(value).pair_out()
+    dark.andnot(value).out()
 }
 
 impl LightTree {
@@ -352,6 +387,13 @@ impl LightTree {
     pub(crate) fn pair_importances(&self, pair: u32, x: Vec3, n: Vec3) -> [f32; 2] {
         let c = &self.compact;
         pair_importance::<Fast>(&c.pairs[pair as usize], &c.quant, x, n)
+    }
+
+    /// Compact importances of two pairs at once (see [`quad_importance`]).
+    #[inline(always)]
+    pub(crate) fn quad_importances(&self, a: u32, b: u32, x: Vec3, n: Vec3) -> [f32; 4] {
+        let c = &self.compact;
+        quad_importance::<Fast>(&c.pairs[a as usize], &c.pairs[b as usize], &c.quant, x, n)
     }
 
     /// Index of the pair that holds `node`'s children; `None` for a leaf.

@@ -2,7 +2,7 @@
 //! wherever the exact one is and close to it, both lane implementations bit-identical, and
 //! the compact descents equal to the generic ones bit for bit.
 
-use crate::compact::pair_importance;
+use crate::compact::{pair_importance, quad_importance};
 use crate::lanes::{Fast, Scalar4};
 use crate::tests::{Layout, rand_lights, rand_receiver, tree_configs};
 use crate::{LightTree, NodeId, Rescaled};
@@ -98,10 +98,20 @@ fn lane_implementations_agree() {
                 1 => x * 1e4,
                 _ => x,
             };
-            for p in &c.pairs {
+            for (i, p) in c.pairs.iter().enumerate() {
                 let a = pair_importance::<Fast>(p, &c.quant, x, n);
                 let b = pair_importance::<Scalar4>(p, &c.quant, x, n);
                 assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "{a:?} vs {b:?}");
+                // Four lanes from two pairs: each pair's lanes as on their own.
+                let other = &c.pairs[(i * 7 + 3) % c.pairs.len()];
+                let o = pair_importance::<Scalar4>(other, &c.quant, x, n);
+                let want = [a[0], a[1], o[0], o[1]].map(f32::to_bits);
+                for q in [
+                    quad_importance::<Fast>(p, other, &c.quant, x, n),
+                    quad_importance::<Scalar4>(p, other, &c.quant, x, n),
+                ] {
+                    assert_eq!(q.map(f32::to_bits), want);
+                }
             }
         }
     }

@@ -1,5 +1,6 @@
-//! Two nodes' arithmetic at once: a four-lane f32 vector whose lanes 0 and 1 hold the left and
-//! the right child of a node pair (lanes 2 and 3 are spare). SSE2 on x86_64 (always present
+//! Four nodes' arithmetic at once: a four-lane f32 vector whose lanes hold the two children of
+//! one node pair (lanes 0, 1) and of another (lanes 2, 3). Lanes never mix, so a node's value
+//! does not depend on what shares the vector. SSE2 on x86_64 (always present
 //! there), plain arrays elsewhere; both use only IEEE-exact operations (+ − × ÷ √, min, max,
 //! compares, bit selects) in the same order, so both give the same bits. Masks are lanes of
 //! all ones or all zeros, in the same type.
@@ -13,8 +14,8 @@ use std::ops::{Add, Div, Mul, Sub};
 pub(crate) trait Lanes:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
 {
-    /// `[left, right, 0, 0]`.
-    fn pair(left: f32, right: f32) -> Self;
+    /// `[a, b, c, d]`.
+    fn quad(a: f32, b: f32, c: f32, d: f32) -> Self;
     fn splat(v: f32) -> Self;
     fn sqrt(self) -> Self;
     /// `self < o ? self : o` per lane (SSE `minps`).
@@ -28,18 +29,18 @@ pub(crate) trait Lanes:
     fn or(self, o: Self) -> Self;
     /// `!self & o`.
     fn andnot(self, o: Self) -> Self;
-    /// Lanes 0 and 1.
-    fn pair_out(self) -> [f32; 2];
+    /// The four lanes.
+    fn out(self) -> [f32; 4];
     /// `mask ? a : b` per lane.
     #[inline(always)]
     fn select(mask: Self, a: Self, b: Self) -> Self {
         mask.and(a).or(mask.andnot(b))
     }
-    /// A mask from two flags.
+    /// A mask from four flags.
     #[inline(always)]
-    fn mask(left: bool, right: bool) -> Self {
+    fn mask(f: [bool; 4]) -> Self {
         let m = |b: bool| f32::from_bits(if b { u32::MAX } else { 0 });
-        Self::pair(m(left), m(right))
+        Self::quad(m(f[0]), m(f[1]), m(f[2]), m(f[3]))
     }
 }
 
@@ -83,8 +84,8 @@ const ONES: u32 = u32::MAX;
 
 impl Lanes for Scalar4 {
     #[inline(always)]
-    fn pair(left: f32, right: f32) -> Self {
-        Scalar4([left, right, 0.0, 0.0])
+    fn quad(a: f32, b: f32, c: f32, d: f32) -> Self {
+        Scalar4([a, b, c, d])
     }
     #[inline(always)]
     fn splat(v: f32) -> Self {
@@ -127,8 +128,8 @@ impl Lanes for Scalar4 {
         self.bits(o, |a, b| !a & b)
     }
     #[inline(always)]
-    fn pair_out(self) -> [f32; 2] {
-        [self.0[0], self.0[1]]
+    fn out(self) -> [f32; 4] {
+        self.0
     }
 }
 
@@ -165,8 +166,8 @@ mod sse {
     // SAFETY (every block below): SSE2 is always available on x86_64; no memory is touched.
     impl Lanes for Sse4 {
         #[inline(always)]
-        fn pair(left: f32, right: f32) -> Self {
-            Sse4(unsafe { _mm_set_ps(0.0, 0.0, right, left) })
+        fn quad(a: f32, b: f32, c: f32, d: f32) -> Self {
+            Sse4(unsafe { _mm_set_ps(d, c, b, a) })
         }
         #[inline(always)]
         fn splat(v: f32) -> Self {
@@ -209,10 +210,10 @@ mod sse {
             Sse4(unsafe { _mm_andnot_ps(self.0, o.0) })
         }
         #[inline(always)]
-        fn pair_out(self) -> [f32; 2] {
+        fn out(self) -> [f32; 4] {
             let mut out = [0.0f32; 4];
             unsafe { _mm_storeu_ps(out.as_mut_ptr(), self.0) };
-            [out[0], out[1]]
+            out
         }
     }
 }

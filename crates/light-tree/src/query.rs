@@ -418,8 +418,12 @@ impl LightTree {
     }
 
     /// [`LightTree::sample_subtree`] from `start` under [`LightTree::importance`], on the
-    /// compact node pairs: one cache line and one two-lane evaluation per level. Bit for bit
-    /// the same result as `sample_subtree(start, |c| self.importance(c, x, n), rng)`.
+    /// compact node pairs. Bit for bit the same result as
+    /// `sample_subtree(start, |c| self.importance(c, x, n), rng)`.
+    ///
+    /// Each level evaluates the grandchildren of both children (two pairs, four lanes) while
+    /// it chooses between the children, so the choice and the next level's arithmetic overlap
+    /// instead of following each other; the lanes of the child not taken are discarded.
     pub fn sample_from<R: DescentRandom>(
         &self,
         start: NodeId,
@@ -431,24 +435,30 @@ impl LightTree {
             return Some((self.nodes[start as usize].child_or_light as usize, 1.0));
         };
         let pairs = &self.compact.pairs;
+        // A leaf has no pair of children: pair 0 stands in and its lanes go unused.
+        let inner = |c: u32| if c & LEAF_BIT == 0 { c } else { 0 };
+        let mut imp = self.pair_importances(pair, x, n).map(sanitize);
         let mut pmf = 1.0f32;
         loop {
             let p = &pairs[pair as usize];
-            self.prefetch_pairs(p.child);
-            let [il, ir] = self.pair_importances(pair, x, n).map(sanitize);
-            let (left, f) = choose(il, ir, rng)?;
+            let (gl, gr) = (inner(p.child[0]), inner(p.child[1]));
+            self.prefetch_pairs(pairs[gl as usize].child);
+            self.prefetch_pairs(pairs[gr as usize].child);
+            let g = self.quad_importances(gl, gr, x, n);
+            let (left, f) = choose(imp[0], imp[1], rng)?;
             pmf *= f;
             let next = p.child[if left { 0 } else { 1 }];
             if next & LEAF_BIT != 0 {
                 return Some(((next & !LEAF_BIT) as usize, pmf));
             }
+            imp = if left { [g[0], g[1]] } else { [g[2], g[3]] }.map(sanitize);
             pair = next;
         }
     }
 
     /// Probability that [`LightTree::sample_from`] from `start` returns `light` (0 if `light`
     /// is not under `start`); equal to `pmf_subtree(start, |c| self.importance(c, x, n),
-    /// light)`.
+    /// light)`. The trail is known, so two levels are evaluated at once.
     pub fn pmf_from(&self, start: NodeId, x: Vec3, n: Vec3, light: usize) -> f32 {
         let leaf = self.leaf_of[light];
         let (first, last) = self.subtree_range(start);
@@ -461,22 +471,40 @@ impl LightTree {
         let start_depth = self.nodes[start as usize].depth();
         // `start` is interior here, so its depth is below 64.
         let mut bits = self.trails[light] >> start_depth;
-        let levels = self.nodes[leaf as usize].depth() - start_depth;
+        let mut levels = self.nodes[leaf as usize].depth() - start_depth;
         let pairs = &self.compact.pairs;
-        let mut pmf = 1.0f32;
-        for _ in 0..levels {
-            let p = &pairs[pair as usize];
-            let side = (bits & 1) as usize;
-            // Only the next pair on the trail matters here.
-            self.prefetch_pairs([p.child[side], LEAF_BIT]);
-            let [il, ir] = self.pair_importances(pair, x, n).map(sanitize);
+        let step = |il: f32, ir: f32, side: u64| {
+            let (il, ir) = (sanitize(il), sanitize(ir));
             let sum = il + ir;
-            if sum == 0.0 {
-                return 0.0;
+            (sum != 0.0).then(|| if side == 0 { il / sum } else { ir / sum })
+        };
+        let mut pmf = 1.0f32;
+        while levels > 0 {
+            let p = &pairs[pair as usize];
+            let next = p.child[(bits & 1) as usize];
+            if levels == 1 {
+                let [il, ir] = self.pair_importances(pair, x, n);
+                let Some(f) = step(il, ir, bits & 1) else {
+                    return 0.0;
+                };
+                return pmf * f;
             }
-            pmf *= if side == 0 { il / sum } else { ir / sum };
-            pair = p.child[side];
-            bits >>= 1;
+            // `next` is interior: evaluate this level and the next in one go.
+            let q = &pairs[next as usize];
+            let after = q.child[((bits >> 1) & 1) as usize];
+            self.prefetch_pairs([after, LEAF_BIT]);
+            let v = self.quad_importances(pair, next, x, n);
+            let Some(f) = step(v[0], v[1], bits & 1) else {
+                return 0.0;
+            };
+            pmf *= f;
+            let Some(f) = step(v[2], v[3], (bits >> 1) & 1) else {
+                return 0.0;
+            };
+            pmf *= f;
+            pair = after;
+            bits >>= 2;
+            levels -= 2;
         }
         pmf
     }
