@@ -628,6 +628,15 @@ fn depth_is_bounded_on_adversarial_input() {
 fn build_errors() {
     let good = LightBounds::point(Vec3::ZERO, 1.0);
     assert_eq!(LightTree::build(&[]).unwrap_err(), BuildError::NoLights);
+    // Finite lights whose common box overflows f32: the compact codes cannot span it.
+    let far = [
+        LightBounds::point(Vec3::splat(-3e38), 1.0),
+        LightBounds::point(Vec3::splat(3e38), 1.0),
+    ];
+    assert_eq!(
+        LightTree::build(&far).unwrap_err(),
+        BuildError::BoundsTooLarge
+    );
     let cases: Vec<(LightBounds, BuildError)> = vec![
         (
             LightBounds {
