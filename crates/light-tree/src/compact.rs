@@ -218,6 +218,8 @@ pub(crate) struct Compact {
     pub(crate) pairs: Vec<NodePair>,
     /// Per node: `2 · pair + side` of the slot that holds it.
     pub(crate) slot_of: Vec<u32>,
+    /// Per pair: the node whose children it holds (`NodeId::MAX` for pair 0, the root's).
+    pub(crate) parent: Vec<u32>,
 }
 
 impl Compact {
@@ -242,6 +244,7 @@ impl Compact {
             .map(|i| slot(&quant, &nodes[i], &extra[i]))
             .collect();
         let mut pairs = vec![NodePair::default(); count as usize];
+        let mut parent = vec![u32::MAX; count as usize];
         let mut slot_of = vec![0u32; nodes.len()];
         pairs[0].set(0, &slots[0], child_code(0));
         // The empty right slot: zero power, so its importance is 0 (a valid axis keeps NaN
@@ -251,6 +254,7 @@ impl Compact {
         for (id, node) in nodes.iter().enumerate() {
             if let Some((l, r)) = node.children(id as u32) {
                 let p = pair_of[id];
+                parent[p as usize] = id as u32;
                 for (side, c) in [(0, l as usize), (1, r as usize)] {
                     pairs[p as usize].set(side, &slots[c], child_code(c));
                     slot_of[c] = 2 * p + side as u32;
@@ -261,6 +265,7 @@ impl Compact {
             quant,
             pairs,
             slot_of,
+            parent,
         })
     }
 }

@@ -134,6 +134,20 @@ fn compact_descent_matches_the_generic_one() {
             } else {
                 assert!(tree.child_importances(start, x, n).is_none());
             }
+            let (own, sib) = tree.importance_and_sibling(start, x, n);
+            assert_eq!(own.to_bits(), imp(start).to_bits());
+            match sib {
+                None => assert_eq!(start, tree.root()),
+                Some((s, v)) => {
+                    assert_eq!(v.to_bits(), imp(s).to_bits());
+                    // The sibling shares the parent: both sit in one pair, other side.
+                    let (a, b) = (
+                        tree.compact.slot_of[start as usize],
+                        tree.compact.slot_of[s as usize],
+                    );
+                    assert_eq!((a >> 1, a & 1), (b >> 1, 1 - (b & 1)));
+                }
+            }
             let u = rng.random::<u64>();
             let a = tree.sample_from(start, x, n, &mut Rescaled(u));
             let b = tree.sample_subtree(start, imp, &mut Rescaled(u));

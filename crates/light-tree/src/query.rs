@@ -388,6 +388,30 @@ impl LightTree {
         self.pair_importances(s >> 1, x, n)[(s & 1) as usize]
     }
 
+    /// [`LightTree::importance`] of `node` and, from the same evaluation, of its sibling
+    /// (`None` for the root): for memos that can keep both.
+    #[inline]
+    pub fn importance_and_sibling(
+        &self,
+        node: NodeId,
+        x: Vec3,
+        n: Vec3,
+    ) -> (f32, Option<(NodeId, f32)>) {
+        let s = self.compact.slot_of[node as usize];
+        let (pair, side) = (s >> 1, (s & 1) as usize);
+        let v = self.pair_importances(pair, x, n);
+        let parent = self.compact.parent[pair as usize];
+        if parent == u32::MAX {
+            return (v[0], None);
+        }
+        let sibling = if side == 0 {
+            self.nodes[parent as usize].child_or_light
+        } else {
+            parent + 1
+        };
+        (v[side], Some((sibling, v[1 - side])))
+    }
+
     /// The importances [`LightTree::importance`] of the two children of `node` (`None` for
     /// a leaf), from one evaluation of their pair.
     #[inline]
