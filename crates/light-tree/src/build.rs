@@ -510,11 +510,13 @@ impl LightTree {
                 node_trail[node.child_or_light as usize] = t | (1u64 << node.depth());
             }
         }
+        let compact = crate::compact::Compact::build(&nodes, &extra)?;
         Ok(LightTree {
             nodes,
             extra,
             leaf_of,
             trails,
+            compact,
         })
     }
 }

@@ -68,7 +68,11 @@
 #![warn(missing_docs)]
 
 mod build;
+mod compact;
+#[cfg(test)]
+mod compact_tests;
 mod cone;
+mod lanes;
 mod query;
 mod sg;
 #[cfg(test)]
@@ -184,6 +188,8 @@ pub enum BuildError {
         /// Emitters given.
         emitters: usize,
     },
+    /// The lights' bounding box is too large for f32 arithmetic (an extent overflows).
+    BoundsTooLarge,
     /// An [`SgEmitter`] with a negative variance or a mean direction longer than 1.
     BadEmitter {
         /// Index of the rejected emitter.
@@ -218,6 +224,9 @@ impl fmt::Display for BuildError {
                     f,
                     "light tree: light {light} has a zero axis but theta_o < pi"
                 )
+            }
+            BuildError::BoundsTooLarge => {
+                write!(f, "light tree: the lights' bounding box overflows f32")
             }
             BuildError::EmitterCount { lights, emitters } => {
                 write!(
@@ -375,6 +384,8 @@ pub struct LightTree {
     leaf_of: Vec<NodeId>,
     /// Per light: bit k = 1 if the path from the root took the right child at depth k.
     trails: Vec<u64>,
+    /// The quantised node pairs the descent reads.
+    compact: compact::Compact,
 }
 
 impl LightTree {

@@ -14,14 +14,14 @@ use rand::{Rng, RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 use std::f32::consts::{FRAC_PI_2, PI};
 
-fn rand_dir(rng: &mut impl Rng) -> Vec3 {
+pub(crate) fn rand_dir(rng: &mut impl Rng) -> Vec3 {
     let z = 1.0 - 2.0 * rng.random::<f32>();
     let r = (1.0 - z * z).max(0.0).sqrt();
     let phi = 2.0 * PI * rng.random::<f32>();
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
-fn rand_in_box(rng: &mut impl Rng, h: f32) -> Vec3 {
+pub(crate) fn rand_in_box(rng: &mut impl Rng, h: f32) -> Vec3 {
     Vec3::new(
         rng.random::<f32>() * 2.0 - 1.0,
         rng.random::<f32>() * 2.0 - 1.0,
@@ -30,7 +30,7 @@ fn rand_in_box(rng: &mut impl Rng, h: f32) -> Vec3 {
 }
 
 #[derive(Clone, Copy, Debug)]
-enum Layout {
+pub(crate) enum Layout {
     /// Uniform in [-1, 1]³.
     Uniform,
     /// All lights at the same point.
@@ -69,7 +69,7 @@ fn rand_light(rng: &mut impl Rng, p: Vec3, zero_power_ok: bool) -> LightBounds {
     }
 }
 
-fn rand_lights(
+pub(crate) fn rand_lights(
     rng: &mut impl Rng,
     n: usize,
     layout: Layout,
@@ -96,7 +96,7 @@ fn rand_lights(
 }
 
 /// Random receiver: a point in [-1.5, 1.5]³ and a normal that is zero one time in four.
-fn rand_receiver(rng: &mut impl Rng) -> (Vec3, Vec3) {
+pub(crate) fn rand_receiver(rng: &mut impl Rng) -> (Vec3, Vec3) {
     let x = rand_in_box(rng, 1.5);
     let n = if rng.random::<f32>() < 0.25 {
         Vec3::ZERO
@@ -131,7 +131,7 @@ fn reference_pmf(tree: &LightTree, start: NodeId, imp: &dyn Fn(NodeId) -> f32) -
 }
 
 /// All the sizes and layouts the statistical tests run over.
-fn tree_configs() -> Vec<(usize, Layout, bool)> {
+pub(crate) fn tree_configs() -> Vec<(usize, Layout, bool)> {
     let mut v = Vec::new();
     for n in [1usize, 2, 3, 5, 17, 64] {
         v.push((n, Layout::Uniform, false));
@@ -240,7 +240,8 @@ fn importance_matches_point_light_formulas() {
             (two, two.power * emit2 * recv / d2),
         ] {
             let t = LightTree::build(&[l]).unwrap();
-            let got = t.importance(0, x, n);
+            // The exact importance; the compact one is tested in compact_tests.rs.
+            let got = t.node(0).importance(x, n);
             assert!(
                 (got - expected).abs() <= 1e-4 * expected.max(1e-3),
                 "got {got} expected {expected}"
@@ -627,6 +628,15 @@ fn depth_is_bounded_on_adversarial_input() {
 fn build_errors() {
     let good = LightBounds::point(Vec3::ZERO, 1.0);
     assert_eq!(LightTree::build(&[]).unwrap_err(), BuildError::NoLights);
+    // Finite lights whose common box overflows f32: the compact codes cannot span it.
+    let far = [
+        LightBounds::point(Vec3::splat(-3e38), 1.0),
+        LightBounds::point(Vec3::splat(3e38), 1.0),
+    ];
+    assert_eq!(
+        LightTree::build(&far).unwrap_err(),
+        BuildError::BoundsTooLarge
+    );
     let cases: Vec<(LightBounds, BuildError)> = vec![
         (
             LightBounds {

@@ -51,11 +51,30 @@ impl NodeMemo {
         }
     }
 
+    /// The cached value of `node`, if any.
+    #[inline]
+    pub fn get(&self, node: NodeId) -> Option<f32> {
+        let s = &self.slots[Self::slot(node)];
+        (s.node == node && s.stamp == self.stamp).then_some(s.value)
+    }
+
+    /// Stores `value` for `node` (which must be what `compute` would give it).
+    #[inline]
+    pub fn insert(&mut self, node: NodeId, value: f32) {
+        let stamp = self.stamp;
+        self.slots[Self::slot(node)] = Slot { node, stamp, value };
+    }
+
+    #[inline]
+    fn slot(node: NodeId) -> usize {
+        // Fibonacci hashing: the top 10 bits of the product.
+        (node.wrapping_mul(0x9E37_79B1) >> 22) as usize
+    }
+
     /// The cached value of `node`, or `compute(node)` stored for next time.
     #[inline]
     pub fn get_or(&mut self, node: NodeId, compute: impl FnOnce(NodeId) -> f32) -> f32 {
-        // Fibonacci hashing: the top 10 bits of the product.
-        let slot = (node.wrapping_mul(0x9E37_79B1) >> 22) as usize;
+        let slot = Self::slot(node);
         let stamp = self.stamp;
         let s = &mut self.slots[slot];
         if s.node == node && s.stamp == stamp {

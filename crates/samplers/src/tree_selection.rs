@@ -1,6 +1,5 @@
 //! Light-tree selection (Conty Estevez & Kulla 2018): a single stochastic descent, or
 //! adaptive splitting into a cut with one light drawn per cluster.
-use crate::memo::NodeMemo;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use light_tree::{Cut, LightBounds, LightTree, NodeId, Rescaled, SplitParams};
@@ -8,7 +7,6 @@ use render_core::Vec3;
 use render_core::estimator::ShadingPoint;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
-use std::cell::RefCell;
 use std::collections::VecDeque;
 
 /// The unit of the power the tree aggregates.
@@ -77,22 +75,24 @@ impl TreeSelection {
     }
 }
 
-/// The per-thread buffers of one shading point: the adaptive cut and the importance memo.
+/// The per-thread buffers of one shading point: the adaptive cut.
 #[derive(Default)]
 pub struct TreeScratch {
     cut: Cut,
     queue: VecDeque<NodeId>,
-    memo: RefCell<NodeMemo>,
 }
 
 crate::scratch_pool!(TreeScratch, |s| {
     s.cut.nodes.clear();
     s.queue.clear();
-    s.memo.get_mut().invalidate();
 });
 
-/// The E&K cut of one shading point (none for a single descent) and its memoised node
-/// importances (shared by the picks and every pmf replay), in per-thread scratch.
+/// The E&K cut of one shading point (none for a single descent), in per-thread scratch.
+///
+/// The picks and pmf replays descend the tree's compact node pairs
+/// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per level for
+/// both children. No memo: on `builtin:emissive-mesh` only 338 of 9,724 shading points
+/// replayed a pmf (callgrind, docs/light-tree.md), so its lookups cost more than they saved.
 pub struct TreeState {
     scratch: Pooled<TreeScratch>,
     split: bool,
@@ -101,19 +101,14 @@ pub struct TreeState {
 }
 
 impl TreeState {
+    /// The shading point's position and receiver normal the state was prepared for.
+    pub fn receiver(&self) -> (Vec3, Vec3) {
+        (self.x, self.n)
+    }
+
     /// The cut's nodes (sorted DFS ids), if the selection splits.
     pub fn cut(&self) -> Option<&Cut> {
         self.split.then_some(&self.scratch.cut)
-    }
-
-    /// E&K importance of `node` at this shading point (memoised).
-    #[inline]
-    pub fn importance(&self, tree: &LightTree, node: NodeId) -> f32 {
-        let (x, n) = (self.x, self.n);
-        self.scratch
-            .memo
-            .borrow_mut()
-            .get_or(node, |id| tree.importance(id, x, n))
     }
 }
 
@@ -165,12 +160,12 @@ impl LightSelection for TreeSelection {
         picks: &mut Vec<(u32, f32)>,
     ) {
         let Some(tree) = &self.tree else { return };
-        let imp = |c| state.importance(tree, c);
+        let (x, n) = (state.x, state.n);
         match state.cut() {
             None => {
                 let root = tree.root();
                 if let Some((light, pmf)) =
-                    tree.sample_subtree(root, imp, &mut Rescaled(rng.next_u64()))
+                    tree.sample_from(root, x, n, &mut Rescaled(rng.next_u64()))
                 {
                     picks.push((light as u32, pmf));
                 }
@@ -180,7 +175,7 @@ impl LightSelection for TreeSelection {
                 // the authors' code).
                 for &node in &cut.nodes {
                     let mut u = Rescaled(rng.next_u64());
-                    if let Some((light, pmf)) = tree.sample_subtree(node, imp, &mut u) {
+                    if let Some((light, pmf)) = tree.sample_from(node, x, n, &mut u) {
                         picks.push((light as u32, pmf));
                     }
                 }
@@ -190,11 +185,11 @@ impl LightSelection for TreeSelection {
 
     fn pmf(&self, state: &TreeState, _: &ShadingPoint, light: u32) -> f32 {
         let Some(tree) = &self.tree else { return 0.0 };
-        let imp = |c| state.importance(tree, c);
+        let (x, n) = (state.x, state.n);
         match state.cut() {
-            None => tree.pmf_subtree(tree.root(), imp, light as usize),
+            None => tree.pmf_from(tree.root(), x, n, light as usize),
             Some(cut) => match cut.cluster_of(tree, light as usize) {
-                Some(k) => tree.pmf_subtree(cut.nodes[k], imp, light as usize),
+                Some(k) => tree.pmf_from(cut.nodes[k], x, n, light as usize),
                 None => 0.0,
             },
         }

@@ -125,7 +125,8 @@ impl LearnedSelection {
         let (mut sum_prior, mut sum_w) = (0.0f64, 0.0f64);
         let mut w = [0.0f32; MAX_CLUSTERS];
         for c in 0..k {
-            let prior = sanitize(state.tree.importance(lt, self.cut.nodes[c]));
+            let (x, n) = state.tree.receiver();
+            let prior = sanitize(lt.importance(self.cut.nodes[c], x, n));
             state.q[c] = prior;
             // V̂ = (hits + a)/(rays + a): 1 before any ray, the hit rate after many.
             let v = region.map_or(1.0, |r| (r[c].hits as f32 + a) / (r[c].rays as f32 + a));
@@ -202,8 +203,8 @@ impl LightSelection for LearnedSelection {
         // their dimensions.
         let mut u = Rescaled(rng.next_u64());
         let Some((c, pc)) = cluster else { return };
-        let imp = |id| state.tree.importance(lt, id);
-        if let Some((light, p)) = lt.sample_subtree(self.cut.nodes[c], imp, &mut u) {
+        let (x, n) = state.tree.receiver();
+        if let Some((light, p)) = lt.sample_from(self.cut.nodes[c], x, n, &mut u) {
             picks.push((light as u32, pc * p));
         }
     }
@@ -219,7 +220,7 @@ impl LightSelection for LearnedSelection {
         if !(pc > 0.0) {
             return 0.0;
         }
-        let imp = |id| state.tree.importance(lt, id);
-        pc * lt.pmf_subtree(self.cut.nodes[c], imp, light as usize)
+        let (x, n) = state.tree.receiver();
+        pc * lt.pmf_from(self.cut.nodes[c], x, n, light as usize)
     }
 }

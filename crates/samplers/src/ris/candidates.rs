@@ -69,10 +69,19 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
         self.n_ls + self.n_bo
     }
 
+    /// The tree importance of `id`, memoised; a miss stores its sibling's too, since the
+    /// compact tree evaluates the two together and the descents ask for both.
     fn tree_importance(&self, id: NodeId) -> f32 {
-        self.memo
-            .borrow_mut()
-            .get_or(id, |id| self.tree.importance(id, self.x, self.n))
+        let mut memo = self.memo.borrow_mut();
+        if let Some(v) = memo.get(id) {
+            return v;
+        }
+        let (v, sibling) = self.tree.importance_and_sibling(id, self.x, self.n);
+        memo.insert(id, v);
+        if let Some((s, sv)) = sibling {
+            memo.insert(s, sv);
+        }
+        v
     }
 
     /// LS selection probability of `light` (a single descent under the tree importance).

@@ -29,6 +29,7 @@ use crate::brdf_oriented::importance::{BoRecord, LobeDensity};
 use crate::brdf_oriented::technique::BoState;
 use crate::bsdf_sampling::sample_bsdf;
 use crate::mis::power2;
+use crate::scratch::Pooled;
 use brdf_integrals::CapIntegral;
 use light_tree::LightTree;
 use render_core::Vec3;
@@ -67,6 +68,19 @@ struct Candidate {
     sample: LightSample,
     target: f32,
 }
+
+/// The candidates of one shading point and their resampling weights, in per-thread scratch
+/// (no heap allocation per shading point).
+#[derive(Default)]
+struct RisScratch {
+    candidates: Vec<Candidate>,
+    weights: Vec<f32>,
+}
+
+crate::scratch_pool!(RisScratch, |s| {
+    s.candidates.clear();
+    s.weights.clear();
+});
 
 impl<C: CapIntegral> Ris<C>
 where
@@ -128,8 +142,11 @@ where
         ctx.aux[0] = m as f32;
 
         // Candidates and their resampling weights.
-        let mut candidates: Vec<Candidate> = Vec::with_capacity(m as usize);
-        let mut weights: Vec<f32> = Vec::with_capacity(m as usize);
+        let mut scratch = Pooled::<RisScratch>::take();
+        let RisScratch {
+            candidates,
+            weights,
+        } = &mut *scratch;
         for j in 0..m {
             ctx.counters.technique_samples[TECHNIQUE_CANDIDATES] += 1;
             let Some(d) = source.sample(j, rng) else {
@@ -158,7 +175,7 @@ where
         let mut l = Vec3::ZERO;
         // The kept candidate: one shadow ray.
         let u = rng.next_f32();
-        if let Some((k, total)) = resample::pick(&weights, u) {
+        if let Some((k, total)) = resample::pick(weights, u) {
             ctx.counters.technique_samples[TECHNIQUE_RIS] += 1;
             let c = &candidates[k];
             let s = &c.sample;

@@ -1,0 +1,425 @@
+//! Compact nodes for the descent (issue 22): the two children of a node side by side in one
+//! 64-byte cache line, with quantised bounds, and their two importances evaluated together in
+//! SIMD lanes with no transcendental function (pbrt-v4's `CompactLightBounds` idea, laid out
+//! as a pair).
+//!
+//! Every quantisation rounds towards more importance, so the compact bounds contain the exact
+//! ones and the compact importance is zero only where the exact one is:
+//! * boxes: 16 bits per coordinate over the root box, lower corners rounded down and upper
+//!   corners up (checked against the decoding arithmetic itself);
+//! * the cone axis: 16 bits per component, normalised when decoded; the angle between the
+//!   decoded and the exact axis (plus 1e-5 rad of slack) is added to θo;
+//! * cos θo and cos θe: 16 bits, rounded down (wider angles); sin θo is √(1 − cos²θo) of the
+//!   rounded cosine, so the pair stays one angle;
+//! * the half-space flag is set only if the widened θo + θe ≤ π/2 still holds.
+//!
+//! Power stays f32, as do all products (Φ · cos θ′ · cos θ′ᵢ / d² in f32, as in the exact
+//! importance).
+
+use crate::lanes::{Fast, Lanes};
+use crate::{BuildError, FLAG_HALF_SPACE, FLAG_TWO_SIDED, LightTree, Node, NodeExtra};
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Set in [`NodePair::child`] for a leaf: the low bits are then its light.
+pub(crate) const LEAF_BIT: u32 = 1 << 31;
+/// Largest box code.
+const QMAX: u32 = u16::MAX as u32;
+/// Scale of the signed cosine and axis codes.
+const QSIGNED: f32 = i16::MAX as f32;
+
+/// Floor of the squared distance, as in the exact importance.
+const MIN_DIST_SQ: f32 = 1e-12;
+/// Emitter cosine floor for θe > π/2, as in the exact importance.
+const MIN_EMIT_COS: f32 = 1e-3;
+/// Slack added to θo beyond the axis' quantisation angle (f32 rounding of the decoded axis).
+const AXIS_SLACK: f64 = 1e-5;
+
+/// The two children of one node, structure-of-arrays, `[left, right]` in each field; 64 bytes.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(64))]
+pub(crate) struct NodePair {
+    /// Box codes: lower x, y, z, then upper x, y, z.
+    qbox: [[u16; 2]; 6],
+    /// Axis codes (x, y, z), normalised when decoded.
+    axis: [[i16; 2]; 3],
+    /// cos θo · 32767, rounded down.
+    cos_o: [i16; 2],
+    /// cos θe · 32767, rounded down.
+    cos_e: [i16; 2],
+    power: [f32; 2],
+    /// Interior child: index of its own pair. Leaf: `LEAF_BIT | light`.
+    pub(crate) child: [u32; 2],
+    /// `FLAG_TWO_SIDED`, `FLAG_HALF_SPACE` of each child.
+    flags: [u8; 2],
+}
+
+/// The box code ↔ position map of one tree: per axis x = origin + code · step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct Quant {
+    origin: [f32; 3],
+    step: [f32; 3],
+}
+
+impl Quant {
+    /// The map over the root box `lo..hi`: code 65535 decodes to ≥ hi.
+    fn new(lo: Vec3, hi: Vec3) -> Result<Quant, BuildError> {
+        let mut q = Quant {
+            origin: lo.to_array(),
+            step: [0.0; 3],
+        };
+        for k in 0..3 {
+            let extent = hi[k] - lo[k];
+            if !extent.is_finite() {
+                return Err(BuildError::BoundsTooLarge);
+            }
+            let mut s = (extent as f64 / QMAX as f64) as f32;
+            while q.origin[k] + QMAX as f32 * s < hi[k] {
+                s = s.next_up();
+            }
+            if !(q.origin[k] + QMAX as f32 * s).is_finite() {
+                return Err(BuildError::BoundsTooLarge);
+            }
+            q.step[k] = s;
+        }
+        Ok(q)
+    }
+
+    /// The position of `code` on axis `k`, exactly as the importance decodes it.
+    #[inline(always)]
+    fn decode(&self, k: usize, code: u16) -> f32 {
+        self.origin[k] + code as f32 * self.step[k]
+    }
+
+    /// The largest code whose position is ≤ v.
+    fn encode_down(&self, k: usize, v: f32) -> u16 {
+        let s = self.step[k];
+        let mut c = if s > 0.0 {
+            ((v as f64 - self.origin[k] as f64) / s as f64)
+                .floor()
+                .clamp(0.0, QMAX as f64) as u32
+        } else {
+            0
+        };
+        while c > 0 && self.decode(k, c as u16) > v {
+            c -= 1;
+        }
+        c as u16
+    }
+
+    /// The smallest code whose position is ≥ v.
+    fn encode_up(&self, k: usize, v: f32) -> u16 {
+        let s = self.step[k];
+        let mut c = if s > 0.0 {
+            ((v as f64 - self.origin[k] as f64) / s as f64)
+                .ceil()
+                .clamp(0.0, QMAX as f64) as u32
+        } else {
+            0
+        };
+        while c < QMAX && self.decode(k, c as u16) < v {
+            c += 1;
+        }
+        c as u16
+    }
+}
+
+/// A cosine code rounded down: the largest c with c / 32767 (as decoded) ≤ `cos`.
+fn encode_cos_down(cos: f64) -> i16 {
+    let mut c = (cos * QSIGNED as f64)
+        .floor()
+        .clamp(-QSIGNED as f64, QSIGNED as f64) as i32;
+    while c > -(i16::MAX as i32) && (decode_cos(c as i16) as f64) > cos {
+        c -= 1;
+    }
+    c as i16
+}
+
+#[inline(always)]
+fn decode_cos(c: i16) -> f32 {
+    // A product rather than a quotient (shorter latency); the encoder checks this very value.
+    c as f32 * (1.0 / QSIGNED)
+}
+
+/// One child's compact bounds, before it is placed in its pair.
+struct Slot {
+    qbox: [u16; 6],
+    axis: [i16; 3],
+    cos_o: i16,
+    cos_e: i16,
+    power: f32,
+    flags: u8,
+}
+
+/// The compact bounds of `node`: see the module docs for the rounding.
+fn slot(q: &Quant, node: &Node, extra: &NodeExtra) -> Slot {
+    let (lo, hi) = node.aabb();
+    let mut qbox = [0u16; 6];
+    for k in 0..3 {
+        qbox[k] = q.encode_down(k, lo[k]);
+        qbox[k + 3] = q.encode_up(k, hi[k]);
+    }
+    let a = node.axis().as_dvec3();
+    let mut axis = [0i16; 3];
+    for k in 0..3 {
+        axis[k] = (a[k] * QSIGNED as f64)
+            .round()
+            .clamp(-QSIGNED as f64, QSIGNED as f64) as i16;
+    }
+    if axis == [0; 3] {
+        axis = [0, 0, i16::MAX];
+    }
+    let decoded = glam::DVec3::new(axis[0] as f64, axis[1] as f64, axis[2] as f64).normalize();
+    let delta = if a.length_squared() > 0.0 {
+        decoded.dot(a.normalize()).clamp(-1.0, 1.0).acos()
+    } else {
+        std::f64::consts::PI
+    };
+    let theta_o = (extra.theta_o as f64 + delta + AXIS_SLACK).min(std::f64::consts::PI);
+    let theta_e = extra.theta_e as f64;
+    let mut flags = 0;
+    if node.two_sided() {
+        flags |= FLAG_TWO_SIDED;
+    } else if node.flags & FLAG_HALF_SPACE != 0 && theta_o + theta_e <= std::f64::consts::FRAC_PI_2
+    {
+        flags |= FLAG_HALF_SPACE;
+    }
+    Slot {
+        qbox,
+        axis,
+        cos_o: encode_cos_down(theta_o.cos()),
+        cos_e: encode_cos_down(theta_e.cos()),
+        power: node.power(),
+        flags,
+    }
+}
+
+impl NodePair {
+    fn set(&mut self, side: usize, s: &Slot, child: u32) {
+        for k in 0..6 {
+            self.qbox[k][side] = s.qbox[k];
+        }
+        for k in 0..3 {
+            self.axis[k][side] = s.axis[k];
+        }
+        self.cos_o[side] = s.cos_o;
+        self.cos_e[side] = s.cos_e;
+        self.power[side] = s.power;
+        self.flags[side] = s.flags;
+        self.child[side] = child;
+    }
+}
+
+#[derive(Clone, Debug)]
+/// The compact layout of a tree: pair 0 holds the root (left) beside an empty slot; every
+/// interior node's children form one pair.
+pub(crate) struct Compact {
+    pub(crate) quant: Quant,
+    pub(crate) pairs: Vec<NodePair>,
+    /// Per node: `2 · pair + side` of the slot that holds it.
+    pub(crate) slot_of: Vec<u32>,
+    /// Per pair: the node whose children it holds (`NodeId::MAX` for pair 0, the root's).
+    pub(crate) parent: Vec<u32>,
+}
+
+impl Compact {
+    pub(crate) fn build(nodes: &[Node], extra: &[NodeExtra]) -> Result<Compact, BuildError> {
+        let (lo, hi) = nodes[0].aabb();
+        let quant = Quant::new(lo, hi)?;
+        // Pair indices in DFS order of the interior nodes, from 1 (0 is the root's pair).
+        let mut pair_of = vec![u32::MAX; nodes.len()];
+        let mut count = 1u32;
+        for (id, node) in nodes.iter().enumerate() {
+            if !node.is_leaf() {
+                pair_of[id] = count;
+                count += 1;
+            }
+        }
+        let child_code = |id: usize| match nodes[id].light() {
+            Some(light) => LEAF_BIT | light as u32,
+            None => pair_of[id],
+        };
+        let slots: Vec<Slot> = (0..nodes.len())
+            .into_par_iter()
+            .map(|i| slot(&quant, &nodes[i], &extra[i]))
+            .collect();
+        let mut pairs = vec![NodePair::default(); count as usize];
+        let mut parent = vec![u32::MAX; count as usize];
+        let mut slot_of = vec![0u32; nodes.len()];
+        pairs[0].set(0, &slots[0], child_code(0));
+        // The empty right slot: zero power, so its importance is 0 (a valid axis keeps NaN
+        // out of its lane).
+        pairs[0].child[1] = LEAF_BIT;
+        pairs[0].axis[2][1] = i16::MAX;
+        for (id, node) in nodes.iter().enumerate() {
+            if let Some((l, r)) = node.children(id as u32) {
+                let p = pair_of[id];
+                parent[p as usize] = id as u32;
+                for (side, c) in [(0, l as usize), (1, r as usize)] {
+                    pairs[p as usize].set(side, &slots[c], child_code(c));
+                    slot_of[c] = 2 * p + side as u32;
+                }
+            }
+        }
+        Ok(Compact {
+            quant,
+            pairs,
+            slot_of,
+            parent,
+        })
+    }
+}
+
+/// The compact E&K importances `[left, right]` of pair `p` for a receiver at `x` with normal
+/// `n` (`Vec3::ZERO`: no receiver term).
+#[inline(always)]
+pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec3) -> [f32; 2] {
+    let v = quad_importance::<L>(p, p, q, x, n);
+    [v[0], v[1]]
+}
+
+/// The compact importances of two pairs at once, `[a.left, a.right, b.left, b.right]`: the
+/// exact importance's formula, term for term, on the decoded bounds, with selects instead of
+/// early exits. Each lane only sees its own node, so a node's value is the same bits in either
+/// pair position and in [`pair_importance`].
+#[inline(always)]
+pub(crate) fn quad_importance<L: Lanes>(
+    a: &NodePair,
+    b: &NodePair,
+    q: &Quant,
+    x: Vec3,
+    n: Vec3,
+) -> [f32; 4] {
+    let code = |ca: [u16; 2], cb: [u16; 2]| {
+        L::quad(ca[0] as f32, ca[1] as f32, cb[0] as f32, cb[1] as f32)
+    };
+    let half_l = L::splat(0.5);
+    let mut c = [L::splat(0.0); 3];
+    let mut h = [L::splat(0.0); 3];
+    for k in 0..3 {
+        let (o, s) = (L::splat(q.origin[k]), L::splat(q.step[k]));
+        let lo = o + code(a.qbox[k], b.qbox[k]) * s;
+        let hi = o + code(a.qbox[k + 3], b.qbox[k + 3]) * s;
+        c[k] = (lo + hi) * half_l - L::splat(x[k]);
+        h[k] = (hi - lo) * half_l;
+    }
+    let dot3 = |a: &[L; 3], b: &[L; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let zero = L::splat(0.0);
+    let one = L::splat(1.0);
+
+    let ax = [0, 1, 2].map(|k| {
+        let (u, v) = (a.axis[k], b.axis[k]);
+        L::quad(u[0] as f32, u[1] as f32, v[0] as f32, v[1] as f32)
+    });
+    let flag = |f: u8| {
+        L::mask([
+            a.flags[0] & f != 0,
+            a.flags[1] & f != 0,
+            b.flags[0] & f != 0,
+            b.flags[1] & f != 0,
+        ])
+    };
+    let cosines = |u: [i16; 2], v: [i16; 2]| {
+        L::quad(
+            decode_cos(u[0]),
+            decode_cos(u[1]),
+            decode_cos(v[0]),
+            decode_cos(v[1]),
+        )
+    };
+    let inv_len = one / dot3(&ax, &ax).sqrt();
+    let ax = ax.map(|v| v * inv_len);
+
+    let has_n = n != Vec3::ZERO;
+    let nv = [L::splat(n.x), L::splat(n.y), L::splat(n.z)];
+    // Box tests: wholly behind the tangent plane; behind the box of a half-space emitter.
+    let mut dark = zero;
+    if has_n {
+        let na = [
+            L::splat(n.x.abs()),
+            L::splat(n.y.abs()),
+            L::splat(n.z.abs()),
+        ];
+        dark = (dot3(&nv, &c) + dot3(&na, &h)).le(zero);
+    }
+    let half_space = flag(FLAG_HALF_SPACE);
+    let behind = (dot3(&ax, &c.map(|v| zero - v)) + dot3(&ax.map(L::abs), &h)).le(zero);
+    dark = dark.or(half_space.and(behind));
+
+    let d2 = dot3(&c, &c);
+    let r2 = dot3(&h, &h);
+    let d2c = d2.max(L::splat(0.25) * r2).max(L::splat(MIN_DIST_SQ));
+    let inside = d2.le(r2);
+    let inv_d = one / d2.sqrt();
+    let w = c.map(|v| v * inv_d);
+    let sin_u = (r2.sqrt() * inv_d).min(one);
+    let cos_u = (one - sin_u * sin_u).max(zero).sqrt();
+
+    // Emitter: θ between the axis and x − c.
+    let mut cos_t = zero - dot3(&ax, &w);
+    let two_sided = flag(FLAG_TWO_SIDED);
+    cos_t = L::select(two_sided, cos_t.abs(), cos_t);
+    let sin_t = (one - cos_t * cos_t).max(zero).sqrt();
+    let cos_o = cosines(a.cos_o, b.cos_o);
+    let cos_e = cosines(a.cos_e, b.cos_e);
+    let sin_o = (one - cos_o * cos_o).max(zero).sqrt();
+    let within = cos_t.ge(cos_o);
+    let cos_x = L::select(within, one, cos_t * cos_o + sin_t * sin_o);
+    let sin_x = L::select(within, zero, sin_t * cos_o - cos_t * sin_o);
+    let cos_p = L::select(cos_x.ge(cos_u), one, cos_x * cos_u + sin_x * sin_u);
+    let mut cone_dark = cos_p.le(cos_e);
+    let emit = cos_p.max(L::splat(MIN_EMIT_COS));
+
+    // Receiver: θi between n and c − x.
+    let recv = if has_n {
+        let cos_i = dot3(&nv, &w);
+        let sin_i = (one - cos_i * cos_i).max(zero).sqrt();
+        let recv = L::select(cos_i.ge(cos_u), one, cos_i * cos_u + sin_i * sin_u);
+        cone_dark = cone_dark.or(recv.le(zero));
+        recv
+    } else {
+        one
+    };
+
+    let power = L::quad(a.power[0], a.power[1], b.power[0], b.power[1]);
+    let outside = power * emit * recv / d2c;
+    let value = L::select(inside, power / d2c, cone_dark.andnot(outside));
+    dark.andnot(value).out()
+}
+
+impl LightTree {
+    /// Compact importances `[left, right]` of pair `pair` on the fast lanes.
+    #[inline(always)]
+    pub(crate) fn pair_importances(&self, pair: u32, x: Vec3, n: Vec3) -> [f32; 2] {
+        let c = &self.compact;
+        pair_importance::<Fast>(&c.pairs[pair as usize], &c.quant, x, n)
+    }
+
+    /// Compact importances of two pairs at once (see [`quad_importance`]).
+    #[inline(always)]
+    pub(crate) fn quad_importances(&self, a: u32, b: u32, x: Vec3, n: Vec3) -> [f32; 4] {
+        let c = &self.compact;
+        quad_importance::<Fast>(&c.pairs[a as usize], &c.pairs[b as usize], &c.quant, x, n)
+    }
+
+    /// Index of the pair that holds `node`'s children; `None` for a leaf.
+    #[inline]
+    pub(crate) fn children_pair(&self, node: u32) -> Option<u32> {
+        let s = self.compact.slot_of[node as usize];
+        let code = self.compact.pairs[(s >> 1) as usize].child[(s & 1) as usize];
+        (code & LEAF_BIT == 0).then_some(code)
+    }
+}
+
+#[cfg(test)]
+impl Compact {
+    /// Decoded box, cos θo and cos θe of the slot holding `node` (tests).
+    pub(crate) fn decoded(&self, node: u32) -> (Vec3, Vec3, f32, f32) {
+        let s = self.slot_of[node as usize];
+        let (p, side) = (&self.pairs[(s >> 1) as usize], (s & 1) as usize);
+        let q = &self.quant;
+        let lo = Vec3::from_array([0, 1, 2].map(|k| q.decode(k, p.qbox[k][side])));
+        let hi = Vec3::from_array([0, 1, 2].map(|k| q.decode(k, p.qbox[k + 3][side])));
+        (lo, hi, decode_cos(p.cos_o[side]), decode_cos(p.cos_e[side]))
+    }
+}
