@@ -4,8 +4,7 @@
 use super::importance::LobeDensity;
 use super::technique::BoState;
 use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
-use crate::learned::regions::Observation;
-use crate::learned::selection::{LearnedSelection, LearnedState};
+use crate::learned::selection::{LearnedSelection, LearnedState, sample_observed};
 use crate::light_strategy::sample_pick;
 use crate::selection::LightSelection;
 use crate::tree_selection::{TreeSelection, TreeState};
@@ -107,7 +106,9 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
             ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
             let sampled = match &self.ls {
                 LsState::Learned(sel, st) => {
-                    sample_observed(scene, sp, light, pmf, rng, ctx, sel, st)
+                    let u = rng.next_2d();
+                    let memory = &mut ctx.pixel_memory[LEARNED_SLOT..];
+                    sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, sel, st)
                 }
                 LsState::Tree(..) => sample_pick(scene, sp, light, pmf, rng, ctx.counters),
             };
@@ -270,41 +271,4 @@ impl LsState<'_> {
             LsState::Learned(s, st) => s.clusters(st),
         }
     }
-}
-
-/// [`sample_pick`] for the learned LS: the same draws and value, and the shadow ray's outcome
-/// left in the pixel's memory for the merge after the pass.
-#[allow(clippy::too_many_arguments)]
-fn sample_observed(
-    scene: &Scene,
-    sp: &ShadingPoint,
-    light: u32,
-    pmf: f32,
-    rng: &mut SampleStream,
-    ctx: &mut SampleContext,
-    sel: &LearnedSelection,
-    st: &LearnedState,
-) -> Option<(render_core::light::LightSample, f32, Vec3)> {
-    let u = rng.next_2d();
-    let s = scene.sample_light(light, sp.point(), u)?;
-    let p = pmf * s.pdf;
-    if !(p > 0.0) {
-        return None;
-    }
-    let f = sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance;
-    if f == Vec3::ZERO {
-        return None;
-    }
-    ctx.counters.shadow_rays += 1;
-    let o = sp.origin_towards(s.wi);
-    let hit = !scene.occluded(o, s.wi, (s.point - o).length());
-    if let Some(cluster) = sel.cluster_of(light) {
-        Observation {
-            key: st.key,
-            cluster,
-            hit,
-        }
-        .write(&mut ctx.pixel_memory[LEARNED_SLOT..], st.stamp);
-    }
-    hit.then_some((s, p, f))
 }

@@ -224,3 +224,41 @@ impl LightSelection for LearnedSelection {
         pc * lt.pmf_from(self.cut.nodes[c], x, n, light as usize)
     }
 }
+
+/// A light sample of a learned pick, shaded with its shadow ray, whose outcome is left in the
+/// pixel's memory from `memory[0]` on for the merge after the pass: `(sample, pmf × point pdf,
+/// f·L)` when the light is visible, `None` otherwise. `u`: the point's random numbers.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn sample_observed(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    light: u32,
+    pmf: f32,
+    u: glam::Vec2,
+    counters: &mut render_core::stats::Counters,
+    memory: &mut [f32],
+    sel: &LearnedSelection,
+    state: &LearnedState,
+) -> Option<(render_core::light::LightSample, f32, render_core::Vec3)> {
+    let s = scene.sample_light(light, sp.point(), u)?;
+    let p = pmf * s.pdf;
+    if !(p > 0.0) {
+        return None;
+    }
+    let f = sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance;
+    if f == render_core::Vec3::ZERO {
+        return None;
+    }
+    counters.shadow_rays += 1;
+    let o = sp.origin_towards(s.wi);
+    let hit = !scene.occluded(o, s.wi, (s.point - o).length());
+    if let Some(cluster) = sel.cluster_of(light) {
+        super::regions::Observation {
+            key: state.key,
+            cluster,
+            hit,
+        }
+        .write(memory, state.stamp);
+    }
+    hit.then_some((s, p, f))
+}

@@ -2,7 +2,7 @@
 //! one BSDF sample, power heuristic), each light sample leaving its visibility in the
 //! pixel's memory for the merge between passes.
 use super::regions::Observation;
-use super::selection::LearnedSelection;
+use super::selection::{LearnedSelection, sample_observed};
 use crate::bsdf_sampling::sample_bsdf;
 use crate::light_strategy::{Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
 use crate::mis::power2;
@@ -65,7 +65,6 @@ impl DirectLighting for LearnedStrategy {
             let table = sel.table.read().unwrap_or_else(|e| e.into_inner());
             sel.prepare_with(scene, sp, &table)
         };
-        let stamp = state.stamp;
         Observation::clear(&mut ctx.pixel_memory[..]);
         ctx.counters
             .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
@@ -77,27 +76,17 @@ impl DirectLighting for LearnedStrategy {
         // dimensions.
         let u = rng.next_2d();
         ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
-        if let Some(&(light, pmf)) = picks.0.first()
-            && let Some(s) = scene.sample_light(light, x, u)
-            && pmf * s.pdf > 0.0
-        {
-            let p = pmf * s.pdf;
-            let f = sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance;
-            if f != Vec3::ZERO {
-                ctx.counters.shadow_rays += 1;
-                let o = sp.origin_towards(s.wi);
-                let hit = !scene.occluded(o, s.wi, (s.point - o).length());
-                if let Some(cluster) = sel.cluster_of(light) {
-                    record(&mut ctx.pixel_memory[..], state.key, cluster, hit, stamp);
-                }
-                if hit {
-                    let w = if self.with_bsdf && !s.is_delta {
-                        power2(p, sp.bsdf.pdf(sp.wo, s.wi))
-                    } else {
-                        1.0
-                    };
-                    l += f * (w / p);
-                }
+        if let Some(&(light, pmf)) = picks.0.first() {
+            let memory = &mut ctx.pixel_memory[..];
+            if let Some((s, p, f)) =
+                sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, sel, &state)
+            {
+                let w = if self.with_bsdf && !s.is_delta {
+                    power2(p, sp.bsdf.pdf(sp.wo, s.wi))
+                } else {
+                    1.0
+                };
+                l += f * (w / p);
             }
         }
         if self.with_bsdf {
@@ -128,8 +117,4 @@ impl DirectLighting for LearnedStrategy {
             .unwrap_or_else(|e| e.into_inner())
             .merge_pass(pixel_memory, 0);
     }
-}
-
-fn record(memory: &mut [f32], key: u64, cluster: usize, hit: bool, stamp: u32) {
-    Observation { key, cluster, hit }.write(memory, stamp);
 }
