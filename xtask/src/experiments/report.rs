@@ -197,6 +197,7 @@ pub fn format_table(
         let _ = write!(s, "---:|");
     }
     let _ = writeln!(s, "---:|---:|");
+    let mut speedups: Vec<Vec<f64>> = vec![Vec::new(); cols.len()];
     for r in rows {
         match marks.get(r) {
             Some(m) => {
@@ -216,7 +217,7 @@ pub fn format_table(
             .map(|e| e.error.mean)
             .fold(f64::INFINITY, f64::min);
         let base = entries.get(&(r.clone(), baseline.to_string()));
-        for e in &row {
+        for (ci, e) in row.iter().enumerate() {
             match e {
                 None => {
                     let _ = write!(s, " – |");
@@ -233,6 +234,7 @@ pub fn format_table(
                         && let Some(x) = speedup(e, b, budget)
                     {
                         v = format!("{v} ({x:.2}×)");
+                        speedups[ci].push(x);
                     }
                     if near_reference(e, ref_noise.get(r).copied()) {
                         v = format!("{v} {REF_FLAG}");
@@ -250,6 +252,29 @@ pub fn format_table(
             }
         }
     }
+    if rows.len() > 1 && speedups.iter().any(|v| !v.is_empty()) {
+        s.push_str(&geomean_row(&speedups, rows.len()));
+    }
+    s
+}
+
+/// The closing row of a table: per column the geometric mean of its speed-ups (the summary a
+/// reader computes first), with the number of scenes it covers when some lack one.
+fn geomean_row(speedups: &[Vec<f64>], scenes: usize) -> String {
+    let mut s = String::from("| *geometric mean* |");
+    for v in speedups {
+        if v.is_empty() {
+            s.push_str(" – |");
+            continue;
+        }
+        let g = (v.iter().map(|x| x.ln()).sum::<f64>() / v.len() as f64).exp();
+        if v.len() == scenes {
+            let _ = write!(s, " *{g:.2}×* |");
+        } else {
+            let _ = write!(s, " *{g:.2}×* of {} scenes |", v.len());
+        }
+    }
+    s.push_str(" | |\n");
     s
 }
 
@@ -417,6 +442,8 @@ mod tests {
             "| sceneB ‡ | **2.00e-2** (1.00×) | 3.00e-2 (0.67×) | – | – | – |"
         );
         // equal time: speed-up = error ratio = 4
+        // geometric means of (1.00, 1.00) and of (2.00, 0.67): 1 and sqrt(2 · 2/3)
+        assert_eq!(lines[4], "| *geometric mean* | *1.00×* | *1.15×* | – | | |");
         let t = format_table(&rows, &cols, &m, "E&K", &Budget::Time(1.0), &noise, &marks);
         assert!(t.contains("**1.00e-2 ± 1.00e-3** (4.00×)"), "{t}");
         assert_eq!(count_near_reference(&m, &noise), 0);
