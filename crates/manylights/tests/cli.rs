@@ -734,6 +734,31 @@ fn scene_hash_covers_included_files_and_render_records_what_strategy_resolves() 
     let resolved = json_of(&manylights(&args));
     assert_eq!(resolved["parameters"]["method"]["lambda"], 3.0);
     assert_eq!(resolved["parameters"]["method"]["n_max"], 50, "a default");
+    assert_eq!(resolved["emission_rays"], 16, "the method's default");
+    for other in [
+        vec![
+            "strategy",
+            "--json",
+            "--strategy",
+            "mis3-adaptive",
+            "--reproduce",
+        ],
+        vec!["strategy", "--json", "--strategy", "tree-split+bsdf"],
+        vec![
+            "strategy",
+            "--json",
+            "--strategy",
+            "mis3-adaptive",
+            "--emission-rays",
+            "1",
+        ],
+    ] {
+        assert_eq!(
+            json_of(&manylights(&other))["emission_rays"],
+            1,
+            "{other:?}"
+        );
+    }
     let out = dir.join("r.exr");
     let mut args = vec!["render", s, "--spp", "1", "--width", "8", "--height", "6"];
     args.extend(flags);
@@ -743,6 +768,7 @@ fn scene_hash_covers_included_files_and_render_records_what_strategy_resolves() 
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
     assert_eq!(meta["resolved_strategy"], resolved);
+    assert_eq!(meta["emission_rays"], 16);
     assert_eq!(meta["scene_hash"], b);
     let o = manylights(&["strategy", "--strategy", "no-such"]);
     assert!(!o.status.success());
