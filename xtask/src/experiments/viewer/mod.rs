@@ -66,6 +66,32 @@ fn cell_render(out: &Path, cell: &CellResult) -> Option<(Vec<Vec3>, Option<Vec<b
     Some((px, mask))
 }
 
+/// The cells of an existing `viewer/<scene>.js` by id (none if it is absent or unreadable).
+fn previous_cells(path: &Path) -> std::collections::HashMap<String, Value> {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Default::default();
+    };
+    let json = text
+        .trim_end()
+        .strip_prefix("MLV.scene(")
+        .and_then(|t| t.strip_suffix(");"))
+        .and_then(|t| serde_json::from_str::<Value>(t).ok());
+    let Some(Value::Array(cells)) = json.map(|mut j| j["cells"].take()) else {
+        return Default::default();
+    };
+    cells
+        .into_iter()
+        .filter_map(|c| Some((c["id"].as_str()?.to_string(), c)))
+        .collect()
+}
+
+/// Whether a viewer entry shows this cell's result (same spp and error, to parse precision),
+/// not an earlier render under the same id.
+fn same_cell(old: &Value, c: &CellResult) -> bool {
+    let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() <= 1e-12 * b.abs());
+    old["spp"].as_u64() == Some(c.spp as u64) && close(old["rel_mse"].as_f64(), c.unlit.rel_mse)
+}
+
 /// The data of one scene: what `viewer/<scene>.js` hands to the page.
 fn scene_data(
     exp: &Experiment,
@@ -101,6 +127,7 @@ fn scene_data(
     } else {
         (w, h) = (1, 1);
     }
+    let previous = previous_cells(&out.join("viewer").join(format!("{}.js", slug(scene))));
     let mut budgets = Vec::new();
     let mut items = Vec::new();
     for budget in super::summary::budgets(exp) {
@@ -126,13 +153,23 @@ fn scene_data(
                 None => (Value::Null, Value::Null),
             };
             // the harness's HDR-ꟻLIP map of this render (ꟻLIP is not computed in the page)
-            let flip_map = match image {
+            let mut flip_map = match image {
                 Value::Null => Value::Null,
                 _ => flips
                     .map_png(c)
                     .and_then(|b| flip_map_uri(&b, w, h))
                     .map_or(Value::Null, Value::String),
             };
+            let (mut image, mut unlit) = (image, unlit);
+            if image.is_null()
+                && let Some(old) = previous.get(&c.id).filter(|o| same_cell(o, c))
+            {
+                // a checkout without `renders/` (a fresh clone merging results) keeps the
+                // images the committed viewer already has for this very cell
+                image = old["image"].clone();
+                unlit = old["unlit"].clone();
+                flip_map = old["flip_map"].clone();
+            }
             items.push(json!({
                 "strategy": col,
                 "budget": label,

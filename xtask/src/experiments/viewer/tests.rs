@@ -365,3 +365,27 @@ fn stale_scene_data_is_removed() {
     assert!(dir.join("index.html").is_file());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn images_of_the_committed_viewer_are_kept_only_for_the_same_cell() {
+    let dir = std::env::temp_dir().join(format!("xtask-viewer-keep-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut c = crate::experiments::tests::cell_result("s__A__spp4__seed0", "r", "c");
+    c.unlit.rel_mse = 1.2345678901234567e-2;
+    let js = dir.join("s.js");
+    let entry = serde_json::json!({"cells": [{"id": c.id, "spp": c.spp, "rel_mse": c.unlit.rel_mse,
+        "image": "data:image/png;base64,AA", "unlit": null, "flip_map": null}]});
+    std::fs::write(&js, format!("MLV.scene({entry});\n")).unwrap();
+    let previous = super::previous_cells(&js);
+    let old = &previous[&c.id];
+    assert_eq!(old["image"], "data:image/png;base64,AA");
+    assert!(super::same_cell(old, &c));
+    // a re-rendered cell under the same id (another error) does not get the old image
+    c.unlit.rel_mse *= 1.001;
+    assert!(!super::same_cell(old, &c));
+    assert!(super::previous_cells(&dir.join("absent.js")).is_empty());
+    std::fs::write(&js, "not a viewer file").unwrap();
+    assert!(super::previous_cells(&js).is_empty());
+    let _ = std::fs::remove_dir_all(&dir);
+}
