@@ -86,6 +86,7 @@ mod tests {
 
     /// f·cos against the independent formula, over directions on both sides of the 41.8° quirk.
     #[test]
+    #[allow(clippy::approx_constant)] // φ = 3.14159: just short of π, on purpose
     fn eval_matches_pbrt_v3_formula() {
         for &(kd, ks, alpha) in &[(0.3, 0.7, 0.008), (0.1, 0.7, 0.3), (0.5, 0.25, 0.8)] {
             for &(to, ti, phi) in &[
