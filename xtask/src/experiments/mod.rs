@@ -174,14 +174,22 @@ fn list() -> Result<ExitCode, String> {
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .collect();
     files.sort();
+    let now = provenance::clean_code_state(&repo_root());
     for f in files {
         match config::load(&f) {
-            Ok(e) => println!(
-                "{:<18} {:>5} cells  {}",
-                e.name,
-                plan::expand(&e).len(),
-                e.description
-            ),
+            Ok(e) => {
+                let cells = repo_root().join("results").join(&e.name).join("cells.json");
+                let fresh =
+                    provenance::Freshness::of(&provenance::cell_code_states(&cells), now.as_ref());
+                println!(
+                    "{:<18} {:>5} cells  {}\n{:<26}{}",
+                    e.name,
+                    plan::expand(&e).len(),
+                    e.description,
+                    "",
+                    fresh.describe(now.is_some())
+                )
+            }
             Err(err) => println!("{:<18} INVALID: {err}", f.display()),
         }
     }

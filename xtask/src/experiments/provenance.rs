@@ -57,25 +57,36 @@ fn git(root: &Path, args: &[&str]) -> Option<String> {
         .then(|| String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
-/// The code state of the tree at `root`, whose `manylights` binary is `exe`.
-pub fn code_state(root: &Path, exe: &Path) -> Result<CodeState, String> {
-    let commit = git(root, &["rev-parse", "--short=12", "HEAD"]).map(|s| s.trim().to_string());
+/// The code state of a clean tree at `root` (HEAD and its `tree:` id); `None` when the tree
+/// is dirty under [`CODE_PATHS`] or not in git.
+pub fn clean_code_state(root: &Path) -> Option<CodeState> {
+    let commit = git(root, &["rev-parse", "--short=12", "HEAD"])?
+        .trim()
+        .to_string();
     let mut status_args = vec!["status", "--porcelain", "--untracked-files=no", "--"];
     status_args.extend(CODE_PATHS);
-    let clean = git(root, &status_args).map(|s| s.trim().is_empty());
-    if let (Some(commit), Some(true)) = (&commit, clean) {
-        // HEAD:path for each path that exists at HEAD (.cargo may not).
-        let objects: Vec<String> = CODE_PATHS
-            .iter()
-            .filter_map(|p| git(root, &["rev-parse", &format!("HEAD:{p}")]))
-            .map(|s| s.trim().to_string())
-            .collect();
-        return Ok(CodeState {
-            id: format!("tree:{}", hex_hash(objects.join(" ").as_bytes())),
-            commit: Some(commit.clone()),
-            dirty: false,
-        });
+    if !git(root, &status_args)?.trim().is_empty() {
+        return None;
     }
+    // HEAD:path for each path that exists at HEAD (.cargo may not).
+    let objects: Vec<String> = CODE_PATHS
+        .iter()
+        .filter_map(|p| git(root, &["rev-parse", &format!("HEAD:{p}")]))
+        .map(|s| s.trim().to_string())
+        .collect();
+    Some(CodeState {
+        id: format!("tree:{}", hex_hash(objects.join(" ").as_bytes())),
+        commit: Some(commit),
+        dirty: false,
+    })
+}
+
+/// The code state of the tree at `root`, whose `manylights` binary is `exe`.
+pub fn code_state(root: &Path, exe: &Path) -> Result<CodeState, String> {
+    if let Some(clean) = clean_code_state(root) {
+        return Ok(clean);
+    }
+    let commit = git(root, &["rev-parse", "--short=12", "HEAD"]).map(|s| s.trim().to_string());
     let bytes =
         std::fs::read(exe).map_err(|e| format!("cannot read {} to hash it: {e}", exe.display()))?;
     Ok(CodeState {
@@ -83,6 +94,74 @@ pub fn code_state(root: &Path, exe: &Path) -> Result<CodeState, String> {
         commit,
         dirty: true,
     })
+}
+
+/// How the committed results of an experiment stand against the code of today's tree.
+#[derive(Debug, PartialEq, Eq)]
+pub enum Freshness {
+    /// No cell files.
+    NoResults,
+    /// Every cell was rendered by the code state of today's clean tree.
+    Current { commit: String },
+    /// One clean code state, not today's (or today's tree is dirty, so none can be current).
+    Older { commit: String },
+    /// Cells of several code states, or of a dirty build.
+    Mixed { states: usize },
+}
+
+impl Freshness {
+    /// The cells' code states (`code` of each cell JSON, or the legacy commit) against `now`,
+    /// today's clean code state if the tree is clean.
+    pub fn of(cells: &[CodeState], now: Option<&CodeState>) -> Freshness {
+        let states: BTreeSet<&CodeState> = cells.iter().collect();
+        let Some(first) = states.first() else {
+            return Freshness::NoResults;
+        };
+        if states.len() > 1 || first.dirty {
+            return Freshness::Mixed {
+                states: states.len(),
+            };
+        }
+        let commit = first.commit.clone().unwrap_or_else(|| "unknown".into());
+        match now {
+            Some(n) if n.id == first.id => Freshness::Current { commit },
+            _ => Freshness::Older { commit },
+        }
+    }
+
+    /// One line for `run-experiments --list`; `tree_clean`: today's tree is clean under
+    /// [`CODE_PATHS`].
+    pub fn describe(&self, tree_clean: bool) -> String {
+        match self {
+            Freshness::NoResults => "no results".into(),
+            Freshness::Current { commit } => format!("results at {commit}: today's code"),
+            Freshness::Older { commit } if tree_clean => {
+                format!("results at {commit}: the code has changed since")
+            }
+            Freshness::Older { commit } => {
+                format!("results at {commit} (today's tree is dirty: not compared)")
+            }
+            Freshness::Mixed { states: 1 } => "results of a dirty build".into(),
+            Freshness::Mixed { states } => format!("results of {states} code states"),
+        }
+    }
+}
+
+/// The code states of the cells in `results/NAME/cells.json` (empty if there is none).
+pub fn cell_code_states(cells_json: &Path) -> Vec<CodeState> {
+    let Ok(text) = std::fs::read_to_string(cells_json) else {
+        return Vec::new();
+    };
+    let Ok(cells) = serde_json::from_str::<Vec<serde_json::Value>>(&text) else {
+        return Vec::new();
+    };
+    cells
+        .iter()
+        .map(|c| {
+            serde_json::from_value::<CodeState>(c["code"].clone())
+                .unwrap_or_else(|_| CodeState::legacy(&c["render"]))
+        })
+        .collect()
 }
 
 /// What besides the plan and the code determines a cell's image, as the binary reports it.
@@ -213,5 +292,55 @@ impl Provenance {
             mixed_rows,
             dirty,
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn state(id: &str, commit: &str, dirty: bool) -> CodeState {
+        CodeState {
+            id: id.into(),
+            commit: Some(commit.into()),
+            dirty,
+        }
+    }
+
+    /// `--list` says a table is today's only when every cell has today's clean code state.
+    #[test]
+    fn freshness_of_committed_results() {
+        let now = state("tree:a", "c1", false);
+        assert_eq!(Freshness::of(&[], Some(&now)), Freshness::NoResults);
+        let same = [state("tree:a", "c0", false), state("tree:a", "c0", false)];
+        // Another commit with the same code paths renders the same images: current.
+        assert_eq!(
+            Freshness::of(&same, Some(&now)),
+            Freshness::Current {
+                commit: "c0".into()
+            }
+        );
+        let old = [state("tree:b", "c0", false)];
+        assert_eq!(
+            Freshness::of(&old, Some(&now)),
+            Freshness::Older {
+                commit: "c0".into()
+            }
+        );
+        // A dirty tree today: nothing can be called current.
+        assert!(matches!(
+            Freshness::of(&same, None),
+            Freshness::Older { .. }
+        ));
+        let mixed = [state("tree:a", "c0", false), state("tree:b", "c9", false)];
+        assert_eq!(
+            Freshness::of(&mixed, Some(&now)),
+            Freshness::Mixed { states: 2 }
+        );
+        let dirty = [state("binary:x", "c0", true)];
+        assert_eq!(
+            Freshness::of(&dirty, Some(&now)),
+            Freshness::Mixed { states: 1 }
+        );
     }
 }
