@@ -74,7 +74,7 @@ pub struct RunArgs {
     /// Print the cells that would run and exit.
     #[arg(long)]
     pub dry_run: bool,
-    /// Results directory (default results/<experiment>).
+    /// Results directory (default `results/<experiment>`).
     #[arg(long)]
     pub results: Option<PathBuf>,
 }
@@ -87,7 +87,7 @@ pub struct RunArgs {
 pub struct MergeArgs {
     #[arg(long, default_value = "quick")]
     pub experiment: String,
-    /// Result directories of shards (each a copy of some machine's results/<experiment>/).
+    /// Result directories of shards (each a copy of some machine's `results/<experiment>/`).
     pub sources: Vec<PathBuf>,
     #[arg(long)]
     pub results: Option<PathBuf>,
@@ -196,7 +196,7 @@ fn list() -> Result<ExitCode, String> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// A notice about something skipped or failed, kept in results/<exp>/notices.json.
+/// A notice about something skipped or failed, kept in `results/<exp>/notices.json`.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq, Eq, PartialOrd, Ord)]
 pub struct Notice {
     pub what: String,

@@ -1,4 +1,4 @@
-//! Writes results/<experiment>/{cells.csv, cells.json, table.md, plots/, strips/, index.html} from the
+//! Writes `results/<experiment>/{cells.csv, cells.json, table.md, plots/, strips/, index.html}` from the
 //! finished cell files (needs no renderer: `merge-results` runs it too).
 use super::charts::{self, Series};
 use super::compositing::{self, StripColumn};
