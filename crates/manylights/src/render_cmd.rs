@@ -77,9 +77,9 @@ pub struct RenderArgs {
 pub struct StrategyArgs {
     #[arg(long, default_value = "power+bsdf")]
     pub strategy: String,
-    /// Where the samples' numbers come from: `independent` numbers per dimension (the default),
+    /// Where the samples' numbers come from: `independent` numbers per dimension,
     /// `stratified` (jittered, needs --spp), `sobol` (Owen-scrambled (0,2)-sequences per
-    /// dimension pair), `lowdiscrepancy` (pbrt-v3's, the default under --reproduce) or
+    /// dimension pair), `lowdiscrepancy` (pbrt-v3's scrambled (0,2)-sequence, the default) or
     /// `zsobol` (pbrt-v4's: one sequence over the image in Morton order, needs --spp). A
     /// scene file's own `Sampler` is used when this is not given.
     #[arg(long, value_parser = sampler_parser())]
@@ -122,8 +122,8 @@ impl StrategyArgs {
     }
 
     /// The strategy's name, every parameter it renders with (defaults filled in) and the
-    /// sampler flag (none: the scene file's, or `lowdiscrepancy` under `--reproduce`, or
-    /// `independent`; the scene's choice is covered by its `scene_hash`): what the render's
+    /// sampler flag (none: the scene file's, else `lowdiscrepancy`; the scene's choice is
+    /// covered by its `scene_hash`): what the render's
     /// JSON records as `resolved_strategy`.
     pub fn resolved(&self) -> anyhow::Result<serde_json::Value> {
         let parameters = samplers::resolve::resolved_parameters(&self.strategy, &self.options())?;
@@ -212,7 +212,7 @@ fn bo_importance_parser() -> impl clap::builder::TypedValueParser<Value = BoImpo
 }
 
 /// The sampler a render uses, and why: `--sampler`, else the scene file's, else pbrt-v3's
-/// `lowdiscrepancy` under `--reproduce`, else `independent`.
+/// `lowdiscrepancy` (under `--reproduce` and by default).
 fn choose_sampler(
     flag: Option<Sampler>,
     scene: &render_core::scene::Scene,
@@ -222,9 +222,11 @@ fn choose_sampler(
         (Some(s), _) => (s, "--sampler"),
         (None, Some(s)) => (s, "scene file"),
         (None, None) if reproduce => (Sampler::LowDiscrepancy, "--reproduce"),
-        // The samplers experiment (results/samplers): at equal time Sobol beat independent numbers
-        // by 1.39× (MIS adaptive) and 1.12× (E&K) in geometric mean, lowdiscrepancy 1.35× / 1.13×.
-        (None, None) => (Sampler::Sobol, "default"),
+        // The samplers experiment (results/samplers, rerun at c353c0d): at equal time pbrt-v3's
+        // lowdiscrepancy beat independent numbers by 1.33× (MIS adaptive) and 1.08× (E&K) in
+        // geometric mean, Sobol by 1.21× / 1.03× (the run at ef738dd had them level and chose
+        // Sobol); docs/samplers.md.
+        (None, None) => (Sampler::LowDiscrepancy, "default"),
     }
 }
 

@@ -560,6 +560,19 @@ fn pbrt_scenes_info_convert_render_and_errors() {
     );
 }
 
+/// Without `--sampler` (and no `Sampler` in the scene) the render takes the default the
+/// samplers experiment chose, and says so.
+#[test]
+fn default_sampler_is_lowdiscrepancy_and_recorded_as_default() {
+    let dir = temp_dir("sampler-default");
+    let o = render_to(&dir, "d", &[]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let meta: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("d.json")).unwrap()).unwrap();
+    assert_eq!(meta["sampler"], "lowdiscrepancy");
+    assert_eq!(meta["sampler_from"], "default");
+}
+
 #[test]
 fn sampler_and_filter_are_chosen_and_recorded() {
     let dir = temp_dir("sampler-filter");
