@@ -330,5 +330,27 @@ fn threads_strategy_parameters_and_code_rerender_exactly_their_cells() {
         },
     )
     .unwrap();
+
+    // a commit that changes nothing under the code paths (docs, results) is the same code
+    // state: cells recorded at it are kept, whatever commit they name
+    let now = code_of("MIS");
+    b.edit_cells(
+        |_| true,
+        |c| c.code.as_mut().unwrap().commit = Some("fedcba987654".into()),
+    );
+    let d = b.run(2, false);
+    assert!(d.rendered.is_empty(), "{:?}", d.rendered);
+    assert_eq!(d.reused.len(), 12);
+    assert_eq!(code_of("MIS").id, now.id);
+    // and a table of them is one code state: named, not refused, no row marked
+    let perm = Permissions {
+        allow_dirty: true,
+        current: Some(now),
+        ..Permissions::default()
+    };
+    summary::generate(&b.exp, &b.out(), &b.base.join("refs"), &[], &perm).unwrap();
+    let md = std::fs::read_to_string(b.out().join("table.md")).unwrap();
+    assert!(md.contains("with the same code"), "{md}");
+    assert!(!md.contains("rows marked ‡"), "{md}");
     let _ = std::fs::remove_dir_all(&b.base);
 }

@@ -426,7 +426,10 @@ enum Outcome {
 }
 
 /// Whether a stored cell can be kept for `cell`: the same plan, reference, loaded scene,
-/// resolved strategy and (time budgets) threads, and the same code unless `reuse_stale`.
+/// resolved strategy and (time budgets) threads, and the same code unless `reuse_stale`. The
+/// code is compared by its id (the tree of the code paths, or the binary's hash), not by the
+/// commit it was rendered at: a later commit that changes only docs or results renders the
+/// same images.
 pub fn is_current(
     stored: &CellResult,
     cell: &Cell,
@@ -438,7 +441,7 @@ pub fn is_current(
     stored.key == cell_key(cell)
         && stored.reference == reference_id
         && stored.inputs.as_ref() == Some(inputs)
-        && (reuse_stale || stored.code.as_ref() == Some(code))
+        && (reuse_stale || stored.code.as_ref().is_some_and(|c| c.id == code.id))
 }
 
 impl CellRenderer<'_> {

@@ -248,10 +248,24 @@ fn code_words(p: &Provenance) -> String {
             " — **it includes cells of a dirty build (written with --allow-dirty): not a committed state**",
         );
     }
+    // Commits that agree on the code paths are one code state: named, not marked.
+    let same_code: Vec<String> = p
+        .states
+        .iter()
+        .filter(|(st, _)| *st != main && st.id == main.id)
+        .map(|(st, n)| format!("{} ({n} cells)", st.describe()))
+        .collect();
+    if !same_code.is_empty() {
+        s.push_str(&format!(
+            " and, with the same code ({}), {}",
+            main.id,
+            same_code.join(", ")
+        ));
+    }
     let others: Vec<String> = p
         .states
         .iter()
-        .filter(|(st, _)| *st != main)
+        .filter(|(st, _)| st.id != main.id)
         .map(|(st, n)| format!("{} ({n} cells)", st.describe()))
         .collect();
     if !others.is_empty() {
