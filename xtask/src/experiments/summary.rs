@@ -6,7 +6,7 @@ use super::config::{BudgetClock, Experiment};
 use super::flip_cells;
 use super::flip_table;
 use super::plan::{self, Budget, slug};
-use super::provenance::{Permissions, Provenance};
+use super::provenance::{CodeState, Permissions, Provenance};
 use super::report::{self, CellResult, Entry, Pixels};
 use super::{Notice, cell_key};
 use std::collections::{BTreeMap, BTreeSet};
@@ -249,12 +249,18 @@ fn code_words(p: &Provenance) -> String {
         );
     }
     // Commits that agree on the code paths are one code state: named, not marked.
-    let same_code: Vec<String> = p
+    let (same_code, others): (Vec<_>, Vec<_>) = p
         .states
         .iter()
-        .filter(|(st, _)| *st != main && st.id == main.id)
-        .map(|(st, n)| format!("{} ({n} cells)", st.describe()))
-        .collect();
+        .filter(|(st, _)| *st != main)
+        .partition(|(st, _)| st.id == main.id);
+    let words = |states: Vec<(&CodeState, &usize)>| -> Vec<String> {
+        states
+            .into_iter()
+            .map(|(st, n)| format!("{} ({n} cells)", st.describe()))
+            .collect()
+    };
+    let (same_code, others) = (words(same_code), words(others));
     if !same_code.is_empty() {
         s.push_str(&format!(
             " and, with the same code ({}), {}",
@@ -262,12 +268,6 @@ fn code_words(p: &Provenance) -> String {
             same_code.join(", ")
         ));
     }
-    let others: Vec<String> = p
-        .states
-        .iter()
-        .filter(|(st, _)| st.id != main.id)
-        .map(|(st, n)| format!("{} ({n} cells)", st.describe()))
-        .collect();
     if !others.is_empty() {
         s.push_str(&format!(
             "; also {}: rows marked {MIXED_MARK} hold cells of another code state or several references ({})",
