@@ -83,6 +83,12 @@ impl ContentHasher {
 
     /// 32 hex digits.
     pub fn finish(&self) -> String {
+        let [a, b] = self.finish_words();
+        format!("{a:016x}{b:016x}")
+    }
+
+    /// The hash as two 64-bit words (the digits of [`ContentHasher::finish`]).
+    pub fn finish_words(&self) -> [u64; 2] {
         let mix = |mut h: u64| {
             h ^= h >> 33;
             h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
@@ -90,11 +96,27 @@ impl ContentHasher {
             h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
             h ^ (h >> 33)
         };
-        format!(
-            "{:016x}{:016x}",
+        [
             mix(self.a ^ self.words),
-            mix(self.b.wrapping_add(self.words))
-        )
+            mix(self.b.wrapping_add(self.words)),
+        ]
+    }
+}
+
+/// The texel digests of the textures met so far, keyed by allocation: a texture shared by
+/// many materials or lights (an emissive texture is shared by every triangle light cut from
+/// it: 2,720 on the ToyCar) is hashed once and then stands in the scene's hash by its
+/// 128-bit digest. The digest is of the content, so two copies of one texture hash alike.
+#[derive(Default)]
+struct TextureDigests(std::collections::HashMap<*const Texture, [u64; 2]>);
+
+impl TextureDigests {
+    fn of(&mut self, t: &Texture) -> [u64; 2] {
+        *self.0.entry(t as *const Texture).or_insert_with(|| {
+            let mut h = ContentHasher::default();
+            t.texels.iter().for_each(|&v| h.write_vec4(v));
+            h.finish_words()
+        })
     }
 }
 
@@ -118,6 +140,7 @@ impl Scene {
     /// The content hash of the scene as loaded (see the module documentation), 32 hex digits.
     pub fn content_hash(&self) -> String {
         let mut h = ContentHasher::default();
+        let mut digests = TextureDigests::default();
         h.tag("triangles");
         h.write_u64(self.triangles.len() as u64);
         for t in &self.triangles {
@@ -130,12 +153,12 @@ impl Scene {
         h.tag("materials");
         h.write_u64(self.materials.len() as u64);
         for m in &self.materials {
-            hash_material(&mut h, m);
+            hash_material(&mut h, m, &mut digests);
         }
         h.tag("lights");
         h.write_u64(self.lights.len() as u64);
         for l in &self.lights {
-            hash_light(&mut h, l);
+            hash_light(&mut h, l, &mut digests);
         }
         h.tag("distant lights");
         h.write_u64(self.distant_lights.len() as u64);
@@ -161,30 +184,34 @@ impl Scene {
     }
 }
 
-fn hash_texture(h: &mut ContentHasher, t: &Option<std::sync::Arc<Texture>>) {
+fn hash_texture(
+    h: &mut ContentHasher,
+    t: &Option<std::sync::Arc<Texture>>,
+    d: &mut TextureDigests,
+) {
     match t {
         None => h.write_u32(0),
         Some(t) => {
             h.write_u32(1);
             h.write_u32(t.width);
             h.write_u32(t.height);
-            t.texels.iter().for_each(|&v| h.write_vec4(v));
+            d.of(t).iter().for_each(|&w| h.write_u64(w));
         }
     }
 }
 
 /// Its fields, and its BSDF evaluated at fixed directions and texture coordinates: how the
 /// renderer understands the material, so that a change of the material → BSDF step changes it.
-fn hash_material(h: &mut ContentHasher, m: &Material) {
+fn hash_material(h: &mut ContentHasher, m: &Material, d: &mut TextureDigests) {
     h.write_vec3(m.base_color);
-    hash_texture(h, &m.base_color_texture);
+    hash_texture(h, &m.base_color_texture, d);
     h.write_f32(m.metallic);
     h.write_f32(m.roughness);
-    hash_texture(h, &m.metallic_roughness_texture);
+    hash_texture(h, &m.metallic_roughness_texture, d);
     h.write_f32(m.specular);
     h.write_u32(m.double_sided as u32);
     h.write_vec3(m.emission);
-    hash_texture(h, &m.emission_texture);
+    hash_texture(h, &m.emission_texture, d);
     match m.model {
         Model::MetallicRoughness => h.write_u32(0),
         Model::PbrtPlastic { ks, alpha } => {
@@ -209,7 +236,7 @@ fn hash_material(h: &mut ContentHasher, m: &Material) {
     }
 }
 
-fn hash_light(h: &mut ContentHasher, l: &Light) {
+fn hash_light(h: &mut ContentHasher, l: &Light, d: &mut TextureDigests) {
     match &l.shape {
         LightShape::Triangle {
             p,
@@ -234,7 +261,7 @@ fn hash_light(h: &mut ContentHasher, l: &Light) {
         }
     }
     h.write_vec3(l.emission);
-    hash_texture(h, &l.texture);
+    hash_texture(h, &l.texture, d);
     h.write_vec3(l.mean_emission);
     h.write_u32(l.two_sided as u32);
     match &l.spot {
@@ -301,6 +328,38 @@ mod tests {
         );
         // the material's name does not change the image, so not the hash
         assert_eq!(base, scene(|_, m| m.name = "other".into()));
+    }
+
+    /// A texture enters by its content, wherever it is stored: shared or copied, one hash; one
+    /// texel or the slot that holds it changes the hash.
+    #[test]
+    fn a_texture_counts_by_content_and_slot() {
+        let tex = |v: f32| {
+            let mut texels = vec![Vec4::splat(0.5); 4];
+            texels[3] = Vec4::splat(v);
+            Some(std::sync::Arc::new(Texture::new(2, 2, texels)))
+        };
+        let base = scene(|_, m| m.base_color_texture = tex(0.5));
+        assert_eq!(base, scene(|_, m| m.base_color_texture = tex(0.5)));
+        assert_ne!(base, scene(|_, _| {}));
+        assert_ne!(base, scene(|_, m| m.base_color_texture = tex(0.6)));
+        assert_ne!(base, scene(|_, m| m.metallic_roughness_texture = tex(0.5)));
+        let shared = scene(|_, m| {
+            let t = tex(0.5);
+            m.base_color_texture = t.clone();
+            m.metallic_roughness_texture = t;
+        });
+        let copies = scene(|_, m| {
+            m.base_color_texture = tex(0.5);
+            m.metallic_roughness_texture = tex(0.5);
+        });
+        assert_eq!(shared, copies);
+        assert_ne!(shared, base);
+        let other = scene(|_, m| {
+            m.base_color_texture = tex(0.5);
+            m.metallic_roughness_texture = tex(0.6);
+        });
+        assert_ne!(shared, other);
     }
 
     #[test]
