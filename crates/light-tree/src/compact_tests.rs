@@ -167,3 +167,38 @@ fn compact_descent_matches_the_generic_one() {
         }
     }
 }
+
+/// `importances` gives each node's `importance`, bit for bit, for node lists in any order:
+/// cuts (siblings side by side), random lists with repeats, the empty list.
+#[test]
+fn batched_importances_match_one_call_per_node() {
+    let mut rng = Pcg32::seed_from_u64(45);
+    for (tree, _) in trees(&mut rng) {
+        let count = tree.nodes().len() as NodeId;
+        for _ in 0..40 {
+            let (x, n) = rand_receiver(&mut rng);
+            let mut lists = vec![Vec::new(), vec![tree.root()]];
+            lists.push(
+                tree.cut(1 + rng.random_range(0..64usize), |_| true)
+                    .nodes
+                    .clone(),
+            );
+            lists.push(
+                (0..rng.random_range(1..50))
+                    .map(|_| rng.random_range(0..count))
+                    .collect(),
+            );
+            for nodes in lists {
+                let mut out = vec![f32::NAN; nodes.len()];
+                tree.importances(&nodes, x, n, &mut out);
+                for (&node, v) in nodes.iter().zip(&out) {
+                    assert_eq!(
+                        v.to_bits(),
+                        tree.importance(node, x, n).to_bits(),
+                        "node {node}"
+                    );
+                }
+            }
+        }
+    }
+}

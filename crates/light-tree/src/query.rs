@@ -388,6 +388,40 @@ impl LightTree {
         self.pair_importances(s >> 1, x, n)[(s & 1) as usize]
     }
 
+    /// [`LightTree::importance`] of each of `nodes`, into `out` (as long as `nodes`): the same
+    /// bits as one call per node, from a quarter of the evaluations when siblings come next to
+    /// each other (as in a cut sorted by DFS id, where a node's sibling, if also in the cut,
+    /// follows it): the pairs holding consecutive nodes are evaluated two at a time.
+    pub fn importances(&self, nodes: &[NodeId], x: Vec3, n: Vec3, out: &mut [f32]) {
+        assert_eq!(nodes.len(), out.len(), "one output per node");
+        let slot = |i: usize| self.compact.slot_of[nodes[i] as usize];
+        // The end of the run of nodes from `i` on that sit in `i`'s pair.
+        let run = |i: usize| {
+            let pair = slot(i) >> 1;
+            (i + 1..nodes.len())
+                .find(|&j| slot(j) >> 1 != pair)
+                .unwrap_or(nodes.len())
+        };
+        let mut i = 0;
+        while i < nodes.len() {
+            let j = run(i);
+            let k = if j < nodes.len() { run(j) } else { j };
+            let b = if j < nodes.len() {
+                slot(j) >> 1
+            } else {
+                slot(i) >> 1
+            };
+            let v = self.quad_importances(slot(i) >> 1, b, x, n);
+            for t in i..j {
+                out[t] = v[(slot(t) & 1) as usize];
+            }
+            for t in j..k {
+                out[t] = v[2 + (slot(t) & 1) as usize];
+            }
+            i = k;
+        }
+    }
+
     /// [`LightTree::importance`] of `node` and, from the same evaluation, of its sibling
     /// (`None` for the root): for memos that can keep both.
     #[inline]

@@ -124,9 +124,13 @@ impl LearnedSelection {
         let a = self.config.prior_strength;
         let (mut sum_prior, mut sum_w) = (0.0f64, 0.0f64);
         let mut w = [0.0f32; MAX_CLUSTERS];
+        // The cut's importances in one batch: its nodes are sorted by DFS id, so siblings sit
+        // side by side and two pairs (four nodes) go through each evaluation.
+        let mut priors = [0.0f32; MAX_CLUSTERS];
+        let (x, n) = state.tree.receiver();
+        lt.importances(&self.cut.nodes[..k], x, n, &mut priors[..k]);
         for c in 0..k {
-            let (x, n) = state.tree.receiver();
-            let prior = sanitize(lt.importance(self.cut.nodes[c], x, n));
+            let prior = sanitize(priors[c]);
             state.q[c] = prior;
             // V̂ = (hits + a)/(rays + a): 1 before any ray, the hit rate after many.
             let v = region.map_or(1.0, |r| (r[c].hits as f32 + a) / (r[c].rays as f32 + a));
