@@ -112,17 +112,25 @@ pub enum Freshness {
 impl Freshness {
     /// The cells' code states (`code` of each cell JSON, or the legacy commit) against `now`,
     /// today's clean code state if the tree is clean.
+    /// A code state is its `id`: cells of several commits with one id (the same code paths)
+    /// are one state, as for reuse and for the table header, and `commit` names them all.
     pub fn of(cells: &[CodeState], now: Option<&CodeState>) -> Freshness {
-        let states: BTreeSet<&CodeState> = cells.iter().collect();
-        let Some(first) = states.first() else {
+        let states: BTreeSet<(&str, bool)> =
+            cells.iter().map(|c| (c.id.as_str(), c.dirty)).collect();
+        let Some(&(_, dirty)) = states.first() else {
             return Freshness::NoResults;
         };
-        if states.len() > 1 || first.dirty {
+        if states.len() > 1 || dirty {
             return Freshness::Mixed {
                 states: states.len(),
             };
         }
-        let commit = first.commit.clone().unwrap_or_else(|| "unknown".into());
+        let first = &cells[0];
+        let commits: BTreeSet<&str> = cells
+            .iter()
+            .map(|c| c.commit.as_deref().unwrap_or("unknown"))
+            .collect();
+        let commit = commits.into_iter().collect::<Vec<_>>().join(" and ");
         match now {
             Some(n) if n.id == first.id => Freshness::Current { commit },
             _ => Freshness::Older { commit },
@@ -318,6 +326,15 @@ mod tests {
             Freshness::of(&same, Some(&now)),
             Freshness::Current {
                 commit: "c0".into()
+            }
+        );
+        // Two commits of one code state (only files outside the code paths changed between
+        // them) are one state, named by both.
+        let two_commits = [state("tree:a", "c0", false), state("tree:a", "c7", false)];
+        assert_eq!(
+            Freshness::of(&two_commits, Some(&now)),
+            Freshness::Current {
+                commit: "c0 and c7".into()
             }
         );
         let old = [state("tree:b", "c0", false)];
