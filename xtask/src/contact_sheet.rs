@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Command, ExitCode};
 
 /// Built-ins at their defaults, then the compositions of real assets (skipped when absent).
-const SCENES: [&str; 15] = [
+const SCENES: [&str; 17] = [
     "builtin:car",
     "builtin:lamp",
     "builtin:statue",
@@ -15,6 +15,8 @@ const SCENES: [&str; 15] = [
     "builtin:glossy-spheres",
     "builtin:diffuse-quads",
     "builtin:grid",
+    "builtin:emissive-mesh",
+    "builtin:rooms",
     "../shared/scenes/bisml_cornell/bisml_cornell.glb",
     "experiments/scenes/toycar.toml",
     "experiments/scenes/buddha.toml",
