@@ -112,12 +112,13 @@ pub enum Freshness {
 impl Freshness {
     /// The cells' code states (`code` of each cell JSON, or the legacy commit) against `now`,
     /// today's clean code state if the tree is clean.
+    ///
     /// A code state is its `id`: cells of several commits with one id (the same code paths)
     /// are one state, as for reuse and for the table header, and `commit` names them all.
     pub fn of(cells: &[CodeState], now: Option<&CodeState>) -> Freshness {
         let states: BTreeSet<(&str, bool)> =
             cells.iter().map(|c| (c.id.as_str(), c.dirty)).collect();
-        let Some(&(_, dirty)) = states.first() else {
+        let Some(&(id, dirty)) = states.first() else {
             return Freshness::NoResults;
         };
         if states.len() > 1 || dirty {
@@ -125,14 +126,13 @@ impl Freshness {
                 states: states.len(),
             };
         }
-        let first = &cells[0];
         let commits: BTreeSet<&str> = cells
             .iter()
             .map(|c| c.commit.as_deref().unwrap_or("unknown"))
             .collect();
         let commit = commits.into_iter().collect::<Vec<_>>().join(" and ");
         match now {
-            Some(n) if n.id == first.id => Freshness::Current { commit },
+            Some(n) if n.id == id => Freshness::Current { commit },
             _ => Freshness::Older { commit },
         }
     }
