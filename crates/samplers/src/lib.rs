@@ -244,6 +244,10 @@ pub fn strategies() -> Vec<StrategyInfo> {
             "every light's unshadowed contribution per point, one light chosen ∝ it (+5 % power), + BSDF sampling, MIS: a floor, O(lights) per point",
         ),
         s(
+            "oracle-shadowed",
+            "oracle with a shadow ray to each of its points per light: a visibility-exact floor (issue 25's bound), O(lights) rays per point",
+        ),
+        s(
             "ris",
             "resampled importance sampling: 8 light-tree + BO candidates, one kept, + BSDF sampling, MIS (ris-N: N candidates)",
         ),
@@ -349,14 +353,15 @@ pub fn create(
             .map_err(StrategyError::BadOption)?,
             with_bsdf: name == "learned+bsdf",
         }),
-        "oracle" => Box::new(LightStrategy {
+        "oracle" | "oracle-shadowed" => Box::new(LightStrategy {
             name: name.into(),
-            selection: oracle::OracleSelection::new(scene),
+            selection: if name == "oracle" {
+                oracle::OracleSelection::new(scene)
+            } else {
+                oracle::OracleSelection::shadowed(scene)
+            },
             with_bsdf: true,
-            parameters: serde_json::json!({
-                "defensive_power_fraction": oracle::DEFENSIVE,
-                "strata_per_side": oracle::STRATA_PER_SIDE,
-            }),
+            parameters: resolve::resolved_parameters(name, opts)?,
         }),
         other if ris_count(other).is_some() => ris(name, ris_count(other).unwrap(), scene, opts)?,
         other => {

@@ -25,11 +25,15 @@ pub const DEFENSIVE: f64 = 0.05;
 /// Strata per side of an area light's stratified estimate (k×k points).
 pub const STRATA_PER_SIDE: u32 = 2;
 
-/// The oracle light selection: each light ∝ its estimated unshadowed contribution at the
-/// shading point, mixed with a defensive power fraction ([`DEFENSIVE`]).
+/// The oracle light selection: each light ∝ its estimated contribution at the shading point,
+/// unshadowed or (the `shadowed` variant) with the visibility of each stratum midpoint, mixed with
+/// a defensive power fraction ([`DEFENSIVE`]).
 pub struct OracleSelection {
     /// Φ_i / ΣΦ, or `None` when no light emits.
     power_pmf: Option<Vec<f64>>,
+    /// Trace a shadow ray to each stratum midpoint and drop the occluded ones (issue 25's bound:
+    /// what a selection that knew visibility exactly would reach).
+    shadowed: bool,
 }
 
 /// The oracle's distribution at one shading point: `cdf[i]` = Σ_{j ≤ i} weight_j (f64, so that a
@@ -45,12 +49,22 @@ impl OracleState {
 }
 
 impl OracleSelection {
-    /// The oracle over `scene`'s lights.
+    /// The unshadowed oracle over `scene`'s lights.
     pub fn new(scene: &Scene) -> OracleSelection {
         let power: Vec<f64> = scene.lights.iter().map(|l| l.power() as f64).collect();
         let total: f64 = power.iter().sum();
         OracleSelection {
             power_pmf: (total > 0.0).then(|| power.iter().map(|p| p / total).collect()),
+            shadowed: false,
+        }
+    }
+
+    /// The shadowed oracle: one shadow ray per stratum midpoint of every light at every shading
+    /// point (O(lights · k²) rays per point, uncounted in the render's ray totals).
+    pub fn shadowed(scene: &Scene) -> OracleSelection {
+        OracleSelection {
+            shadowed: true,
+            ..OracleSelection::new(scene)
         }
     }
 }
@@ -58,9 +72,28 @@ impl OracleSelection {
 /// Luminance of the unshadowed f·L·G of `light` at `sp`, integrated over the light's solid
 /// angle: exact for point lights, the k×k stratum midpoints of the light's own sampling otherwise.
 pub fn unshadowed_contribution(light: &Light, sp: &ShadingPoint) -> f64 {
+    contribution(light, sp, None)
+}
+
+/// [`unshadowed_contribution`] with each stratum midpoint's term kept only where a shadow ray
+/// from `sp` reaches it in `scene`.
+pub fn shadowed_contribution(light: &Light, sp: &ShadingPoint, scene: &Scene) -> f64 {
+    contribution(light, sp, Some(scene))
+}
+
+fn contribution(light: &Light, sp: &ShadingPoint, occluders: Option<&Scene>) -> f64 {
     let x = sp.point();
     let lum = |s: &render_core::light::LightSample| {
-        luminance(sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance) as f64
+        let f = sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance;
+        let blocked = |scene: &Scene| {
+            let o = sp.origin_towards(s.wi);
+            scene.occluded(o, s.wi, (s.point - o).length())
+        };
+        if f == render_core::Vec3::ZERO || occluders.is_some_and(blocked) {
+            0.0
+        } else {
+            luminance(f) as f64
+        }
     };
     if light.is_delta() {
         return light
@@ -122,7 +155,7 @@ impl LightSelection for OracleSelection {
         let c: Vec<f64> = scene
             .lights
             .iter()
-            .map(|l| unshadowed_contribution(l, sp))
+            .map(|l| contribution(l, sp, self.shadowed.then_some(scene)))
             .collect();
         let sum_c: f64 = c.iter().sum();
         // Without any estimated contribution, power sampling alone (still complete).

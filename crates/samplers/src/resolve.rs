@@ -129,6 +129,11 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
             "defensive_power_fraction": oracle::DEFENSIVE,
             "strata_per_side": oracle::STRATA_PER_SIDE,
         }),
+        "oracle-shadowed" => json!({
+            "defensive_power_fraction": oracle::DEFENSIVE,
+            "strata_per_side": oracle::STRATA_PER_SIDE,
+            "shadowed": true,
+        }),
         other if ris_count(other).is_some() => json!({
             "candidates": ris_count(other),
             "delta": opts.delta,

@@ -45,14 +45,27 @@ fn chi2_lights(
     (out.p_value, out.message)
 }
 
+/// The unshadowed oracle and the shadowed one (issue 25's bound).
+fn oracles(scene: &Scene) -> [OracleSelection; 2] {
+    [
+        OracleSelection::new(scene),
+        OracleSelection::shadowed(scene),
+    ]
+}
+
 #[test]
 fn oracle_pmf_sums_to_one_and_covers_every_emitting_light() {
     let scene = common::mixed_scene(40);
-    let oracle = OracleSelection::new(&scene);
-    let sps = shading_points(&scene);
+    for oracle in oracles(&scene) {
+        pmf_sums_to_one_and_covers_every_emitting_light(&scene, &oracle);
+    }
+}
+
+fn pmf_sums_to_one_and_covers_every_emitting_light(scene: &Scene, oracle: &OracleSelection) {
+    let sps = shading_points(scene);
     assert!(sps.len() >= 4);
     for sp in &sps {
-        let state = oracle.prepare(&scene, sp);
+        let state = oracle.prepare(scene, sp);
         let sum: f64 = (0..scene.lights.len())
             .map(|l| oracle.pmf(&state, sp, l as u32) as f64)
             .sum();
@@ -70,9 +83,14 @@ fn oracle_pmf_sums_to_one_and_covers_every_emitting_light() {
 #[test]
 fn oracle_selection_matches_its_pmf_chi2() {
     let scene = common::mixed_scene(40);
-    let oracle = OracleSelection::new(&scene);
-    for (k, sp) in shading_points(&scene).iter().enumerate() {
-        let state = oracle.prepare(&scene, sp);
+    for oracle in oracles(&scene) {
+        selection_matches_its_pmf_chi2(&scene, &oracle);
+    }
+}
+
+fn selection_matches_its_pmf_chi2(scene: &Scene, oracle: &OracleSelection) {
+    for (k, sp) in shading_points(scene).iter().enumerate() {
+        let state = oracle.prepare(scene, sp);
         let mut picks = Vec::new();
         let (p, msg) = chi2_lights(
             scene.lights.len(),
@@ -89,6 +107,57 @@ fn oracle_selection_matches_its_pmf_chi2() {
         );
         assert!(p > 1e-4, "point {k}: p = {p} ({msg})");
     }
+}
+
+/// The shadowed oracle's weight of a light is its unshadowed one with the occluded stratum
+/// midpoints left out: never more, the same for most lights of the open scene, and zero for
+/// every light once an opaque slab hides the floor from all of them (the floor's points then
+/// keep only the defensive power share).
+#[test]
+fn shadowed_oracle_drops_exactly_the_occluded_midpoints() {
+    use samplers::oracle::{shadowed_contribution, unshadowed_contribution};
+    let open = common::mixed_scene(40);
+    // A slab at y = 0.3 over the whole floor: the lights are all above it (y ≥ 0.43).
+    let mut b = common::mixed_scene_builder(40);
+    let slab = b
+        .add_material(render_core::material::Material::diffuse("slab", Vec3::ONE))
+        .unwrap();
+    let p = [(-4.0, -4.0), (4.0, -4.0), (4.0, 4.0), (-4.0, 4.0)].map(|(x, z)| Vec3::new(x, 0.3, z));
+    b.add_mesh(
+        "slab",
+        &p,
+        None,
+        None,
+        &[0, 1, 2, 0, 2, 3],
+        glam::Mat4::IDENTITY,
+        slab,
+    )
+    .unwrap();
+    let walled = b.build().unwrap();
+    assert_eq!(open.lights.len(), walled.lights.len());
+    let (mut same, mut lit, mut floor_pairs) = (0, 0, 0);
+    for sp in &shading_points(&open) {
+        for (l, light) in open.lights.iter().enumerate() {
+            let free = unshadowed_contribution(light, sp);
+            let seen = shadowed_contribution(light, sp, &open);
+            assert!(
+                seen <= free,
+                "light {l}: shadowed {seen} > unshadowed {free}"
+            );
+            lit += (free > 0.0) as usize;
+            same += (free > 0.0 && seen == free) as usize;
+            if sp.point().y.abs() < 1e-3 && free > 0.0 {
+                floor_pairs += 1;
+                let hidden = shadowed_contribution(&walled.lights[l], sp, &walled);
+                assert_eq!(hidden, 0.0, "light {l} seen through the slab");
+            }
+        }
+    }
+    assert!(
+        same * 2 > lit,
+        "{same} of {lit} lit pairs unoccluded in the open scene"
+    );
+    assert!(floor_pairs > 0, "no floor point to hide");
 }
 
 fn ris_strategy(scene: &Scene) -> Ris<Sptd> {

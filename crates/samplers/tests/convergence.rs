@@ -145,6 +145,7 @@ fn oracle_and_ris_agree_with_power_bsdf() {
         let reference = render_sized(scene, "power+bsdf", ref_spp, 2, 1, size);
         for name in [
             "oracle",
+            "oracle-shadowed",
             "ris",
             "ris-1",
             "ris-32",

@@ -97,6 +97,12 @@ pub fn estimate_at_origin(
 /// A glossy-and-diffuse test scene with sphere lights, one- and two-sided triangle lights of
 /// different powers, occluders and a camera: small enough to render in a test.
 pub fn mixed_scene(n_spheres: usize) -> Scene {
+    mixed_scene_builder(n_spheres).build().unwrap()
+}
+
+/// [`mixed_scene`] before its build, for a test that adds geometry after its lights (which
+/// keeps their order).
+pub fn mixed_scene_builder(n_spheres: usize) -> SceneBuilder {
     let mut b = SceneBuilder::new("mixed");
     let glossy = b
         .add_material(Material::simple(
@@ -193,7 +199,7 @@ pub fn mixed_scene(n_spheres: usize) -> Scene {
         48,
         36,
     ));
-    b.build().unwrap()
+    b
 }
 
 pub fn uv(x: f32, y: f32) -> Vec2 {
