@@ -10,6 +10,7 @@ use render_core::sampler::Sampler;
 use render_core::splat::Reconstruction;
 use samplers::StrategyOptions;
 use samplers::brdf_oriented::{BoImportance, BrdfIntegral};
+use samplers::learned::{LearnTarget, LearnedConfig};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -191,6 +192,27 @@ pub struct MethodArgs {
     /// paper, instead of one descent there (--reproduce implies it).
     #[arg(long)]
     pub split_ls_at_glossy: bool,
+    /// Learned selection: what a region learns of each cluster, `contribution` (its observed
+    /// contribution over its prior) or `visibility` (its shadow rays' hit rate).
+    #[arg(long, default_value = LearnedConfig::default().target.name(),
+          value_parser = learn_target_parser())]
+    pub learned_target: LearnTarget,
+    /// Learned selection: clusters of its fixed cut (1–256).
+    #[arg(long, default_value_t = LearnedConfig::default().clusters)]
+    pub learned_clusters: usize,
+    /// Learned selection: region cells per scene diagonal.
+    #[arg(long, default_value_t = LearnedConfig::default().cells_per_diagonal)]
+    pub learned_cells: f32,
+    /// Learned selection: share of the unlearnt prior in its pmf, in (0, 1].
+    #[arg(long, default_value_t = LearnedConfig::default().defensive)]
+    pub learned_defensive: f32,
+}
+
+/// `--learned-target`: the names of [`LearnTarget`], listed in `--help`.
+fn learn_target_parser() -> impl clap::builder::TypedValueParser<Value = LearnTarget> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(LearnTarget::ALL.map(LearnTarget::name))
+        .map(|s| LearnTarget::from_name(&s).expect("a listed name"))
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -281,6 +303,13 @@ impl MethodArgs {
             efficient_total: !self.fixed_n_max,
             stratified: !self.independent_samples,
             split_ls_at_glossy: self.split_ls_at_glossy,
+            learned: LearnedConfig {
+                target: self.learned_target,
+                clusters: self.learned_clusters,
+                cells_per_diagonal: self.learned_cells,
+                defensive: self.learned_defensive,
+                ..LearnedConfig::default()
+            },
         }
     }
 }

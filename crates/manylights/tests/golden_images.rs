@@ -80,6 +80,16 @@ fn variants() -> Vec<(&'static str, StrategyOptions)> {
             },
         ),
         (
+            "learned-visibility",
+            StrategyOptions {
+                learned: samplers::learned::LearnedConfig {
+                    target: samplers::learned::LearnTarget::Visibility,
+                    ..Default::default()
+                },
+                ..d()
+            },
+        ),
+        (
             "pivot-independent",
             StrategyOptions {
                 pivot_sphere: true,
@@ -96,6 +106,7 @@ fn uses_variant(strategy: &str, variant: &str) -> bool {
     match variant {
         "default" => true,
         "reproduce" => strategy.starts_with("tree") || strategy.starts_with("mis3"),
+        "learned-visibility" => strategy.contains("learned"),
         _ => strategy == "mis3-adaptive" || strategy == "ris-adaptive",
     }
 }

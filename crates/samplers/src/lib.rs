@@ -91,6 +91,8 @@ pub struct StrategyOptions {
     pub split_ls_at_glossy: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
+    /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
+    pub learned: learned::LearnedConfig,
 }
 
 /// Our default τ for the unit-free E&K cut, chosen by the equal-time sweep of
@@ -155,6 +157,7 @@ impl Default for StrategyOptions {
             stratified: true,
             split_ls_at_glossy: false,
             adaptive_split: true,
+            learned: learned::LearnedConfig::default(),
         }
     }
 }
@@ -236,7 +239,7 @@ pub fn strategies() -> Vec<StrategyInfo> {
         ),
         s(
             "learned",
-            "learned cluster selection (issue 25): a fixed 64-cluster cut, each cluster weighed by the tree importance × the visibility learnt per region in earlier passes (+20 % the tree importance alone), then the tree's descent",
+            "learned cluster selection (issue 25): a fixed 64-cluster cut, each cluster weighed by the tree importance × its contribution (or visibility) learnt per region in earlier passes (+20 % the tree importance alone), then the tree's descent",
         ),
         s("learned+bsdf", "learned + BSDF sampling, MIS"),
         s(
@@ -345,12 +348,8 @@ pub fn create(
         }
         "learned" | "learned+bsdf" => Box::new(learned::strategy::LearnedStrategy {
             name: name.into(),
-            selection: learned::selection::LearnedSelection::new(
-                scene,
-                units,
-                learned::LearnedConfig::default(),
-            )
-            .map_err(StrategyError::BadOption)?,
+            selection: learned::selection::LearnedSelection::new(scene, units, opts.learned)
+                .map_err(StrategyError::BadOption)?,
             with_bsdf: name == "learned+bsdf",
         }),
         "oracle" | "oracle-shadowed" => Box::new(LightStrategy {
@@ -399,12 +398,8 @@ fn mis3(
     let config = resolve::bo_config(opts);
     let learned = if name == "mis3-adaptive-learned" {
         Some(
-            learned::selection::LearnedSelection::new(
-                scene,
-                opts.power_units(),
-                learned::LearnedConfig::default(),
-            )
-            .map_err(StrategyError::BadOption)?,
+            learned::selection::LearnedSelection::new(scene, opts.power_units(), opts.learned)
+                .map_err(StrategyError::BadOption)?,
         )
     } else {
         None

@@ -116,14 +116,14 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
         "mis3-adaptive-learned" => json!({
             "power_units": units(opts),
             "ls": "learned",
-            "learned": crate::learned::LearnedConfig::default(),
+            "learned": opts.learned,
             "method": bo_config(opts),
             "integral": integral(opts),
         }),
         "learned" | "learned+bsdf" => json!({
             "power_units": units(opts),
             "cut": "breadth-first",
-            "learned": crate::learned::LearnedConfig::default(),
+            "learned": opts.learned,
         }),
         "oracle" => json!({
             "defensive_power_fraction": oracle::DEFENSIVE,

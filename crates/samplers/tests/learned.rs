@@ -10,9 +10,9 @@ use render_core::render::{RenderResult, RenderSettings, render};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use samplers::convergence::compare;
-use samplers::learned::LearnedConfig;
 use samplers::learned::selection::LearnedSelection;
 use samplers::learned::strategy::LearnedStrategy;
+use samplers::learned::{LearnTarget, LearnedConfig};
 use samplers::selection::LightSelection;
 use samplers::tree_selection::PowerUnits;
 use samplers::{StrategyOptions, create};
@@ -21,12 +21,26 @@ fn rooms() -> Scene {
     scene_formats::load_scene("builtin:rooms?lights=400", None).unwrap()
 }
 
-fn learned(scene: &Scene) -> LearnedStrategy {
+fn learned(scene: &Scene, target: LearnTarget) -> LearnedStrategy {
+    let config = LearnedConfig {
+        target,
+        ..LearnedConfig::default()
+    };
     LearnedStrategy {
         name: "learned+bsdf".into(),
-        selection: LearnedSelection::new(scene, PowerUnits::Watts, LearnedConfig::default())
-            .unwrap(),
+        selection: LearnedSelection::new(scene, PowerUnits::Watts, config).unwrap(),
         with_bsdf: true,
+    }
+}
+
+/// Default options but for what the learned selection learns.
+fn options(target: LearnTarget) -> StrategyOptions {
+    StrategyOptions {
+        learned: LearnedConfig {
+            target,
+            ..LearnedConfig::default()
+        },
+        ..StrategyOptions::default()
     }
 }
 
@@ -70,14 +84,19 @@ fn camera_points(scene: &Scene) -> Vec<ShadingPoint> {
 #[test]
 fn learned_picks_follow_their_pmf_within_a_pass_and_replay_it() {
     let scene = rooms();
-    let s = learned(&scene);
+    for target in LearnTarget::ALL {
+        picks_follow_their_pmf(&scene, &learned(&scene, target));
+    }
+}
+
+fn picks_follow_their_pmf(scene: &Scene, s: &LearnedStrategy) {
     // Learn over 6 passes, then sample with the statistics frozen.
-    render(&scene, &s, &settings(&scene, (48, 32), 6, 2), &|_, _| {}).unwrap();
+    render(scene, s, &settings(scene, (48, 32), 6, 2), &|_, _| {}).unwrap();
     let table = s.selection.table.read().unwrap();
     assert!(table.pass == 6 && !table.is_empty(), "it learnt something");
     let mut learnt_points = 0;
-    for (i, sp) in camera_points(&scene).iter().enumerate() {
-        let state = s.selection.prepare_with(&scene, sp, &table);
+    for (i, sp) in camera_points(scene).iter().enumerate() {
+        let state = s.selection.prepare_with(scene, sp, &table);
         if table.region(state.key).is_some() {
             learnt_points += 1;
         }
@@ -135,17 +154,22 @@ fn learned_picks_follow_their_pmf_within_a_pass_and_replay_it() {
 #[test]
 fn learning_moves_probability_off_hidden_clusters() {
     let scene = rooms();
-    let s = learned(&scene);
-    render(&scene, &s, &settings(&scene, (64, 48), 32, 2), &|_, _| {}).unwrap();
+    for target in LearnTarget::ALL {
+        moves_probability_off_hidden_clusters(&scene, &learned(&scene, target));
+    }
+}
+
+fn moves_probability_off_hidden_clusters(scene: &Scene, s: &LearnedStrategy) {
+    render(scene, s, &settings(scene, (64, 48), 32, 2), &|_, _| {}).unwrap();
     let table = s.selection.table.read().unwrap();
     let empty = samplers::learned::regions::RegionTable::new(s.selection.cut.len(), 1);
     let mut checked = 0;
-    for sp in camera_points(&scene) {
-        let learnt = s.selection.prepare_with(&scene, &sp, &table);
+    for sp in camera_points(scene) {
+        let learnt = s.selection.prepare_with(scene, &sp, &table);
         let Some(tallies) = table.region(learnt.key) else {
             continue;
         };
-        let prior = s.selection.prepare_with(&scene, &sp, &empty);
+        let prior = s.selection.prepare_with(scene, &sp, &empty);
         let hidden: Vec<usize> = (0..tallies.len())
             .filter(|&c| tallies[c].rays >= 4 && tallies[c].hits * 4 < tallies[c].rays)
             .collect();
@@ -156,11 +180,61 @@ fn learning_moves_probability_off_hidden_clusters() {
         let p_prior: f32 = hidden.iter().map(|&c| prior.cluster_pmf(c)).sum();
         assert!(
             p_learnt < 0.8 * p_prior,
-            "hidden clusters: learnt {p_learnt} vs prior {p_prior}"
+            "{:?}, hidden clusters: learnt {p_learnt} vs prior {p_prior}",
+            s.selection.config.target
         );
         checked += 1;
     }
     assert!(checked >= 2, "only {checked} points checked");
+}
+
+/// The contribution target's weights, exactly: with cluster 1 observed at ratio 4 and cluster
+/// 2 at ratio 0 (ten rays each), the region's mean ratio is r̄ = 2, so r̂₁ = (40 + 2)/11,
+/// r̂₂ = 2/11 and every other cluster r̂ = r̄, and P(c) = (1 − α)·p_c r̂_c/Σ p r̂ + α·p_c with
+/// p_c the prior alone.
+#[test]
+fn contribution_weights_follow_the_observed_ratios() {
+    let scene = rooms();
+    let s = learned(&scene, LearnTarget::Contribution);
+    let sel = &s.selection;
+    let k = sel.cut.len();
+    let empty = samplers::learned::regions::RegionTable::new(k, 1);
+    let mut checked = 0;
+    for sp in camera_points(&scene) {
+        let prior = sel.prepare_with(&scene, &sp, &empty);
+        let p: Vec<f64> = (0..k).map(|c| prior.cluster_pmf(c) as f64).collect();
+        // Two clusters the prior reaches, observed.
+        let mut reached = (0..k).filter(|&c| p[c] > 1e-3);
+        let (Some(c1), Some(c2)) = (reached.next(), reached.next()) else {
+            continue;
+        };
+        let mut table = samplers::learned::regions::RegionTable::new(k, 4);
+        for _ in 0..10 {
+            table.add(prior.key, c1, true, 4.0);
+            table.add(prior.key, c2, false, 0.0);
+        }
+        let learnt = sel.prepare_with(&scene, &sp, &table);
+        let a = sel.config.prior_strength as f64;
+        let r = |c: usize| match c {
+            _ if c == c1 => (40.0 + 2.0 * a) / (10.0 + a),
+            _ if c == c2 => 2.0 * a / (10.0 + a),
+            _ => 2.0,
+        };
+        let sum: f64 = (0..k).map(|c| p[c] * r(c)).sum();
+        let alpha = sel.config.defensive as f64;
+        for c in 0..k {
+            let expected = (1.0 - alpha) * p[c] * r(c) / sum + alpha * p[c];
+            let got = learnt.cluster_pmf(c) as f64;
+            assert!(
+                (got - expected).abs() <= 1e-5 + 1e-4 * expected,
+                "cluster {c}: {got} vs {expected}"
+            );
+        }
+        assert!(learnt.cluster_pmf(c1) > prior.cluster_pmf(c1));
+        assert!(learnt.cluster_pmf(c2) < prior.cluster_pmf(c2));
+        checked += 1;
+    }
+    assert!(checked >= 3, "only {checked} points checked");
 }
 
 fn assert_bit_identical(a: &RenderResult, b: &RenderResult, name: &str) {
@@ -177,8 +251,12 @@ fn assert_bit_identical(a: &RenderResult, b: &RenderResult, name: &str) {
 #[test]
 fn learned_image_is_identical_for_any_thread_count_and_twice() {
     let scene = rooms();
-    for name in ["learned", "learned+bsdf", "mis3-adaptive-learned"] {
-        let s = create(name, &scene, &StrategyOptions::default()).unwrap();
+    let cases = ["learned", "learned+bsdf", "mis3-adaptive-learned"]
+        .map(|name| (name, LearnTarget::Contribution))
+        .into_iter()
+        .chain([("learned+bsdf", LearnTarget::Visibility)]);
+    for (name, target) in cases {
+        let s = create(name, &scene, &options(target)).unwrap();
         let a = render(
             &scene,
             s.as_ref(),
@@ -193,7 +271,7 @@ fn learned_image_is_identical_for_any_thread_count_and_twice() {
             &|_, _| {},
         )
         .unwrap();
-        assert_bit_identical(&a, &b, name);
+        assert_bit_identical(&a, &b, &format!("{name} ({target:?})"));
         let params = s.parameters();
         let learnt = if name.starts_with("mis3") {
             &params["learned"]
@@ -228,12 +306,16 @@ fn learned_converges_to_power_bsdf() {
             1,
             size,
         );
-        for name in ["learned", "learned+bsdf", "mis3-adaptive-learned"] {
-            let r = common::render_opts(scene, name, &StrategyOptions::default(), spp, 2, 2, size);
+        let cases = ["learned", "learned+bsdf", "mis3-adaptive-learned"]
+            .map(|name| (name, LearnTarget::Contribution))
+            .into_iter()
+            .chain([("learned+bsdf", LearnTarget::Visibility)]);
+        for (name, target) in cases {
+            let r = common::render_opts(scene, name, &options(target), spp, 2, 2, size);
             let failures = compare(&reference, &r, 2, 3.0);
             assert!(
                 failures.is_empty(),
-                "{name} vs power+bsdf on {}:\n{}",
+                "{name} ({target:?}) vs power+bsdf on {}:\n{}",
                 scene.name,
                 failures.join("\n")
             );

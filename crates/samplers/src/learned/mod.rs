@@ -1,6 +1,6 @@
 //! Learned cluster selection (issue 25, after Vévoda et al. 2018): which cluster of a fixed
 //! light-tree cut a shading point samples is weighed by what earlier passes observed of each
-//! cluster's visibility in the point's region, with the unshadowed tree importance as the
+//! cluster in the point's region (its contribution over its prior, or its visibility), with the unshadowed tree importance as the
 //! prior and a defensive share of the prior alone, so that every light the tree can reach
 //! stays reachable.
 //!
@@ -18,11 +18,46 @@ pub mod regions;
 pub mod selection;
 pub mod strategy;
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
+
+/// What a region learns of each cluster, the factor that multiplies its prior at a point.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LearnTarget {
+    /// The hit rate of its shadow rays, V̂ = (hits + a)/(rays + a).
+    Visibility,
+    /// The mean ratio of its observed (shadowed) contribution to its prior,
+    /// (Σ ratio + a·r̄)/(rays + a) with r̄ the region's mean ratio over all clusters: corrects the
+    /// tree importance's own error in the region as well as visibility (closer to Vévoda et
+    /// al.'s regression of the contribution).
+    #[default]
+    Contribution,
+}
+
+impl LearnTarget {
+    /// Every target, in `--help` order.
+    pub const ALL: [LearnTarget; 2] = [LearnTarget::Contribution, LearnTarget::Visibility];
+
+    /// The name the CLI and the JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            LearnTarget::Visibility => "visibility",
+            LearnTarget::Contribution => "contribution",
+        }
+    }
+
+    /// The target called `name`.
+    pub fn from_name(name: &str) -> Option<LearnTarget> {
+        LearnTarget::ALL.into_iter().find(|t| t.name() == name)
+    }
+}
 
 /// Parameters of the learned selection.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
 pub struct LearnedConfig {
+    /// What is learnt per region and cluster.
+    pub target: LearnTarget,
     /// Clusters of the fixed cut (breadth-first from the root).
     pub clusters: usize,
     /// Region cells per scene diagonal (cell edge = diagonal / this).
@@ -38,6 +73,7 @@ pub struct LearnedConfig {
 impl Default for LearnedConfig {
     fn default() -> Self {
         LearnedConfig {
+            target: LearnTarget::default(),
             clusters: 64,
             cells_per_diagonal: 64.0,
             defensive: 0.2,

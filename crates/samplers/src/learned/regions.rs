@@ -1,6 +1,7 @@
 //! Regions of shading points and what was learnt in each: a hash grid over positions (cells of
 //! a fixed size) × six normal buckets (the normal's major axis and its sign), and per region
-//! the visibility tallies of every cluster of the fixed cut, capped in number.
+//! the tallies of every cluster of the fixed cut (visibility and contribution), capped in
+//! number.
 //!
 //! The table is written only between passes (`merge_pass`, pixels in order) and read only
 //! during them, so what a sample sees is fixed before it is drawn and is the same for any
@@ -58,14 +59,16 @@ impl RegionGrid {
     }
 }
 
-/// Visibility tallies of one cluster in one region: shadow rays traced towards it, and how
-/// many of them reached the light.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// Tallies of one cluster in one region: shadow rays traced towards it, how many of them
+/// reached the light, and the sum of the contribution ratios they observed.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Tally {
     /// Shadow rays that reached the light.
     pub hits: u32,
     /// Shadow rays traced.
     pub rays: u32,
+    /// Sum of the observed contribution ratios (0 for an occluded ray).
+    pub ratio_sum: f32,
 }
 
 /// A splitmix64 finaliser as the map's hash: keys are already unique 63-bit values.
@@ -147,7 +150,8 @@ impl RegionTable {
     }
 
     /// Adds one observation: a shadow ray towards cluster `cluster` from region `key`.
-    pub fn add(&mut self, key: u64, cluster: usize, hit: bool) {
+    /// `ratio`: its observed contribution over the cluster's prior (0 when occluded).
+    pub fn add(&mut self, key: u64, cluster: usize, hit: bool, ratio: f32) {
         let k = self.clusters;
         let i = match self.index.get(&key) {
             Some(&i) => i as usize,
@@ -166,6 +170,7 @@ impl RegionTable {
         let t = &mut self.tallies[i * k + cluster];
         t.rays += 1;
         t.hits += hit as u32;
+        t.ratio_sum += ratio;
     }
 
     /// Merges the observations the pass just finished left in the pixels' memory (in pixel
@@ -181,7 +186,7 @@ impl RegionTable {
             if let Some(o) = Observation::read(&m[base..], stamp)
                 && o.cluster < self.clusters
             {
-                self.add(o.key, o.cluster, o.hit);
+                self.add(o.key, o.cluster, o.hit, o.ratio);
             }
         }
         self.pass = stamp;
@@ -189,7 +194,7 @@ impl RegionTable {
 }
 
 /// One sample's observation, kept in its pixel's memory until the pass ends.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Observation {
     /// The region of the shading point.
     pub key: u64,
@@ -197,14 +202,18 @@ pub struct Observation {
     pub cluster: usize,
     /// Whether its shadow ray reached the light.
     pub hit: bool,
+    /// Observed contribution over the cluster's prior importance (0 when occluded).
+    pub ratio: f32,
 }
 
-/// Pixel-memory slots: the pass stamp, three 21-bit parts of the key, the cluster, the hit.
+/// Pixel-memory slots: the pass stamp, three 21-bit parts of the key, the cluster, and the
+/// ratio (0 for a miss, at least the smallest normal f32 for a hit).
 pub const SLOTS: usize = 6;
 const _: () = assert!(SLOTS <= PIXEL_MEMORY);
 
 impl Observation {
-    /// Writes the observation under pass stamp `stamp` (every value an exact integer).
+    /// Writes the observation under pass stamp `stamp` (every value but the ratio an exact
+    /// integer).
     pub fn write(&self, memory: &mut [f32], stamp: u32) {
         let mask = (1u64 << KEY_PART_BITS) - 1;
         memory[0] = stamp as f32;
@@ -212,7 +221,11 @@ impl Observation {
             memory[1 + j] = ((self.key >> (KEY_PART_BITS * j as u32)) & mask) as f32;
         }
         memory[4] = self.cluster as f32;
-        memory[5] = self.hit as u32 as f32;
+        memory[5] = if self.hit {
+            self.ratio.max(f32::MIN_POSITIVE)
+        } else {
+            0.0
+        };
     }
 
     /// Marks the pixel as having no observation in this pass.
@@ -232,6 +245,7 @@ impl Observation {
             key,
             cluster: memory[4] as usize,
             hit: memory[5] != 0.0,
+            ratio: memory[5],
         })
     }
 }
@@ -255,9 +269,17 @@ mod tests {
             key: far,
             cluster: 63,
             hit: true,
+            ratio: 0.375,
         };
         o.write(&mut m, 5);
         assert_eq!(Observation::read(&m, 5), Some(o));
+        // A hit with a zero ratio still reads as a hit; a miss keeps no ratio.
+        let zero = Observation { ratio: 0.0, ..o };
+        zero.write(&mut m, 5);
+        assert!(Observation::read(&m, 5).unwrap().hit);
+        let miss = Observation { hit: false, ..o };
+        miss.write(&mut m, 5);
+        assert_eq!(Observation::read(&m, 5).unwrap().ratio, 0.0);
         assert_eq!(Observation::read(&m, 6), None);
         Observation::clear(&mut m);
         assert_eq!(Observation::read(&m, 5), None);
@@ -266,16 +288,21 @@ mod tests {
     #[test]
     fn the_table_tallies_in_order_and_stops_at_its_cap() {
         let mut t = RegionTable::new(4, 2);
-        t.add(10, 1, true);
-        t.add(10, 1, false);
-        t.add(20, 3, true);
-        t.add(30, 0, true);
+        t.add(10, 1, true, 0.5);
+        t.add(10, 1, false, 0.0);
+        t.add(20, 3, true, 2.0);
+        t.add(30, 0, true, 1.0);
         assert_eq!(t.len(), 2);
         assert_eq!(t.dropped, 1);
-        assert_eq!(t.region(10).unwrap()[1], Tally { hits: 1, rays: 2 });
-        assert_eq!(t.region(20).unwrap()[3], Tally { hits: 1, rays: 1 });
+        let tally = |hits, rays, ratio_sum| Tally {
+            hits,
+            rays,
+            ratio_sum,
+        };
+        assert_eq!(t.region(10).unwrap()[1], tally(1, 2, 0.5));
+        assert_eq!(t.region(20).unwrap()[3], tally(1, 1, 2.0));
         assert!(t.region(30).is_none());
-        assert!(t.memory_bytes() >= 2 * 4 * 8);
+        assert!(t.memory_bytes() >= 2 * 4 * 12);
         t.clear();
         assert!(t.is_empty() && t.pass == 0);
     }

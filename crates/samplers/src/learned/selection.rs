@@ -1,9 +1,10 @@
 //! The learned cluster selection at one shading point: a cluster of the fixed cut by the
-//! posterior weight w_c = prior_c · V̂_c mixed with the prior alone, then the tree's descent
+//! weight w_c = prior_c · r̂_c (r̂_c the region's learnt contribution ratio or hit rate of the
+//! cluster) mixed with the prior alone, then the tree's descent
 //! inside the cluster. `pick` and `pmf` read the same per-point probabilities, so a light's
 //! probability at sampling and at any replay is the same number.
-use super::LearnedConfig;
 use super::regions::{RegionGrid, RegionTable};
+use super::{LearnTarget, LearnedConfig};
 use crate::selection::LightSelection;
 use crate::tree_selection::{PowerUnits, TreeMode, TreeSelection, TreeState};
 use light_tree::{Cut, LightTree, Rescaled};
@@ -48,6 +49,12 @@ impl LearnedSelection {
                 config.defensive, config.prior_strength
             ));
         }
+        if !(config.cells_per_diagonal >= 1.0 && config.cells_per_diagonal <= 1e5) {
+            return Err(format!(
+                "learned selection: cells per scene diagonal must be in [1, 100000], got {}",
+                config.cells_per_diagonal
+            ));
+        }
         let tree = TreeSelection::new(scene, TreeMode::Single, units)?;
         // Breadth-first: clusters of about equal depth, which the SAOH build keeps compact
         // in space (a room's lights, a lamp's bulbs), the unit visibility is learnt for.
@@ -81,6 +88,8 @@ pub struct LearnedState {
     /// Unnormalised probability of each cluster; `total` is their sum.
     q: [f32; MAX_CLUSTERS],
     total: f64,
+    /// Each cluster's prior (unshadowed tree importance) at the point.
+    prior: [f32; MAX_CLUSTERS],
 }
 
 impl LearnedState {
@@ -115,6 +124,7 @@ impl LearnedSelection {
             stamp: table.pass + 1,
             q: [0.0; MAX_CLUSTERS],
             total: 0.0,
+            prior: [0.0; MAX_CLUSTERS],
         };
         let Some(lt) = self.light_tree() else {
             return state;
@@ -129,11 +139,32 @@ impl LearnedSelection {
         let mut priors = [0.0f32; MAX_CLUSTERS];
         let (x, n) = state.tree.receiver();
         lt.importances(&self.cut.nodes[..k], x, n, &mut priors[..k]);
+        let contribution = self.config.target == LearnTarget::Contribution;
+        // The region's mean ratio over every cluster: what a cluster not yet observed there is
+        // expected to have (1 before any ray, which leaves the prior as it is).
+        let mean_ratio = region.map_or(1.0, |r| {
+            let (sum, rays) = r.iter().fold((0.0f64, 0u64), |(s, n), t| {
+                (s + t.ratio_sum as f64, n + t.rays as u64)
+            });
+            if rays > 0 && sum > 0.0 {
+                (sum / rays as f64) as f32
+            } else {
+                1.0
+            }
+        });
         for c in 0..k {
             let prior = sanitize(priors[c]);
             state.q[c] = prior;
-            // V̂ = (hits + a)/(rays + a): 1 before any ray, the hit rate after many.
-            let v = region.map_or(1.0, |r| (r[c].hits as f32 + a) / (r[c].rays as f32 + a));
+            state.prior[c] = prior;
+            let v = match region {
+                None => 1.0,
+                // (Σ ratio + a·r̄)/(rays + a): r̄ before any ray, the mean ratio after many.
+                Some(r) if contribution => {
+                    (r[c].ratio_sum + a * mean_ratio) / (r[c].rays as f32 + a)
+                }
+                // V̂ = (hits + a)/(rays + a): 1 before any ray, the hit rate after many.
+                Some(r) => (r[c].hits as f32 + a) / (r[c].rays as f32 + a),
+            };
             w[c] = prior * v;
             sum_prior += prior as f64;
             sum_w += w[c] as f64;
@@ -257,10 +288,20 @@ pub(crate) fn sample_observed(
     let o = sp.origin_towards(s.wi);
     let hit = !scene.occluded(o, s.wi, (s.point - o).length());
     if let Some(cluster) = sel.cluster_of(light) {
+        // The contribution f/p of the light within its cluster, over the cluster's prior.
+        let pc = state.cluster_pmf(cluster);
+        let prior = state.prior[cluster];
+        let ratio = if hit && pc > 0.0 && prior > 0.0 {
+            let y = render_core::colour::luminance(f) * pc / p;
+            sanitize(y / prior)
+        } else {
+            0.0
+        };
         super::regions::Observation {
             key: state.key,
             cluster,
             hit,
+            ratio,
         }
         .write(memory, state.stamp);
     }
