@@ -239,7 +239,7 @@ pub fn strategies() -> Vec<StrategyInfo> {
         ),
         s(
             "learned",
-            "learned cluster selection (issue 25): a fixed 64-cluster cut, each cluster weighed by the tree importance × its contribution (or visibility) learnt per region in earlier passes (+20 % the tree importance alone), then the tree's descent",
+            "learned cluster selection (issue 25): a fixed 32-cluster cut, each cluster weighed by the tree importance × its contribution (or visibility) learnt per region in earlier passes (+20 % the tree importance alone), then the tree's descent",
         ),
         s("learned+bsdf", "learned + BSDF sampling, MIS"),
         s(

@@ -74,7 +74,7 @@ impl Default for LearnedConfig {
     fn default() -> Self {
         LearnedConfig {
             target: LearnTarget::default(),
-            clusters: 64,
+            clusters: 32,
             cells_per_diagonal: 64.0,
             defensive: 0.2,
             prior_strength: 1.0,
