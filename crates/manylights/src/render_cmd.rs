@@ -206,6 +206,9 @@ pub struct MethodArgs {
     /// Learned selection: share of the unlearnt prior in its pmf, in (0, 1].
     #[arg(long, default_value_t = LearnedConfig::default().defensive)]
     pub learned_defensive: f32,
+    /// `learned`, `learned+bsdf`: light samples per shading point (beside one BSDF sample).
+    #[arg(long, default_value_t = LearnedConfig::default().light_samples)]
+    pub learned_samples: u32,
 }
 
 /// `--learned-target`: the names of [`LearnTarget`], listed in `--help`.
@@ -308,6 +311,7 @@ impl MethodArgs {
                 clusters: self.learned_clusters,
                 cells_per_diagonal: self.learned_cells,
                 defensive: self.learned_defensive,
+                light_samples: self.learned_samples,
                 ..LearnedConfig::default()
             },
         }

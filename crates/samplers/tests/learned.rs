@@ -33,15 +33,27 @@ fn learned(scene: &Scene, target: LearnTarget) -> LearnedStrategy {
     }
 }
 
-/// Default options but for what the learned selection learns.
-fn options(target: LearnTarget) -> StrategyOptions {
+/// Default options but for what the learned selection learns and its light samples per point.
+fn options((target, light_samples): (LearnTarget, u32)) -> StrategyOptions {
     StrategyOptions {
         learned: LearnedConfig {
             target,
+            light_samples,
             ..LearnedConfig::default()
         },
         ..StrategyOptions::default()
     }
+}
+
+/// The strategies and settings the image tests cover: every learned strategy at the defaults,
+/// `learned+bsdf` learning visibility, and with three light samples per point.
+fn cases() -> Vec<(&'static str, (LearnTarget, u32))> {
+    let mut c: Vec<_> = ["learned", "learned+bsdf", "mis3-adaptive-learned"]
+        .map(|name| (name, (LearnTarget::Contribution, 1)))
+        .to_vec();
+    c.push(("learned+bsdf", (LearnTarget::Visibility, 1)));
+    c.push(("learned+bsdf", (LearnTarget::Contribution, 3)));
+    c
 }
 
 fn settings(scene: &Scene, (w, h): (u32, u32), spp: u32, threads: usize) -> RenderSettings {
@@ -251,11 +263,7 @@ fn assert_bit_identical(a: &RenderResult, b: &RenderResult, name: &str) {
 #[test]
 fn learned_image_is_identical_for_any_thread_count_and_twice() {
     let scene = rooms();
-    let cases = ["learned", "learned+bsdf", "mis3-adaptive-learned"]
-        .map(|name| (name, LearnTarget::Contribution))
-        .into_iter()
-        .chain([("learned+bsdf", LearnTarget::Visibility)]);
-    for (name, target) in cases {
+    for (name, target) in cases() {
         let s = create(name, &scene, &options(target)).unwrap();
         let a = render(
             &scene,
@@ -306,11 +314,7 @@ fn learned_converges_to_power_bsdf() {
             1,
             size,
         );
-        let cases = ["learned", "learned+bsdf", "mis3-adaptive-learned"]
-            .map(|name| (name, LearnTarget::Contribution))
-            .into_iter()
-            .chain([("learned+bsdf", LearnTarget::Visibility)]);
-        for (name, target) in cases {
+        for (name, target) in cases() {
             let r = common::render_opts(scene, name, &options(target), spp, 2, 2, size);
             let failures = compare(&reference, &r, 2, 3.0);
             assert!(
@@ -320,5 +324,35 @@ fn learned_converges_to_power_bsdf() {
                 failures.join("\n")
             );
         }
+    }
+}
+
+/// Out-of-range settings are a clear error, never a panic or a silent fallback.
+#[test]
+fn bad_learned_settings_are_errors() {
+    let scene = rooms();
+    let bad = [
+        LearnedConfig {
+            clusters: 0,
+            ..LearnedConfig::default()
+        },
+        LearnedConfig {
+            defensive: 0.0,
+            ..LearnedConfig::default()
+        },
+        LearnedConfig {
+            cells_per_diagonal: 0.0,
+            ..LearnedConfig::default()
+        },
+        LearnedConfig {
+            light_samples: 0,
+            ..LearnedConfig::default()
+        },
+    ];
+    for config in bad {
+        let e = LearnedSelection::new(&scene, PowerUnits::Watts, config)
+            .err()
+            .unwrap_or_else(|| panic!("{config:?} accepted"));
+        assert!(e.starts_with("learned selection:"), "{e}");
     }
 }

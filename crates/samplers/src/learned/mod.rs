@@ -68,6 +68,9 @@ pub struct LearnedConfig {
     pub prior_strength: f32,
     /// Most regions kept (observations of further regions are dropped).
     pub max_regions: usize,
+    /// Light samples per shading point in `learned` and `learned+bsdf` (one BSDF sample
+    /// beside them, power heuristic with counts); the first one's observation is learnt.
+    pub light_samples: u32,
 }
 
 impl Default for LearnedConfig {
@@ -79,6 +82,7 @@ impl Default for LearnedConfig {
             defensive: 0.2,
             prior_strength: 1.0,
             max_regions: 1 << 16,
+            light_samples: 1,
         }
     }
 }

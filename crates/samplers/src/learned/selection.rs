@@ -49,6 +49,12 @@ impl LearnedSelection {
                 config.defensive, config.prior_strength
             ));
         }
+        if !(1..=1024).contains(&config.light_samples) {
+            return Err(format!(
+                "learned selection: light samples per point must be in 1..=1024, got {}",
+                config.light_samples
+            ));
+        }
         if !(config.cells_per_diagonal >= 1.0 && config.cells_per_diagonal <= 1e5) {
             return Err(format!(
                 "learned selection: cells per scene diagonal must be in [1, 100000], got {}",

@@ -1,11 +1,11 @@
 //! Strategies `learned` and `learned+bsdf`: one light by the learned cluster selection (±
 //! one BSDF sample, power heuristic), each light sample leaving its visibility in the
 //! pixel's memory for the merge between passes.
-use super::regions::Observation;
+use super::regions::{Observation, SLOTS};
 use super::selection::{LearnedSelection, sample_observed};
 use crate::bsdf_sampling::sample_bsdf;
 use crate::light_strategy::{Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
-use crate::mis::power2;
+use crate::mis::power_heuristic;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use render_core::Vec3;
@@ -69,24 +69,35 @@ impl DirectLighting for LearnedStrategy {
         ctx.counters
             .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
         let mut picks = Pooled::<Picks>::take();
-        sel.pick(&state, sp, rng, &mut picks.0);
         let x = sp.point();
         let mut l = Vec3::ZERO;
-        // The point on the light is drawn even without a pick, so later draws keep their
-        // dimensions.
-        let u = rng.next_2d();
-        ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
-        if let Some(&(light, pmf)) = picks.0.first() {
-            let memory = &mut ctx.pixel_memory[..];
+        let n = sel.config.light_samples.max(1);
+        // Where the second and later samples' observations go (one is learnt per pass).
+        let mut unlearnt = [0.0f32; SLOTS];
+        for i in 0..n {
+            picks.0.clear();
+            sel.pick(&state, sp, rng, &mut picks.0);
+            // The point on the light is drawn even without a pick, so later draws keep their
+            // dimensions.
+            let u = rng.next_2d();
+            ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
+            let Some(&(light, pmf)) = picks.0.first() else {
+                continue;
+            };
+            let memory = if i == 0 {
+                &mut ctx.pixel_memory[..]
+            } else {
+                &mut unlearnt[..]
+            };
             if let Some((s, p, f)) =
                 sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, sel, &state)
             {
                 let w = if self.with_bsdf && !s.is_delta {
-                    power2(p, sp.bsdf.pdf(sp.wo, s.wi))
+                    power_heuristic(0, &[(n as f32, p), (1.0, sp.bsdf.pdf(sp.wo, s.wi))])
                 } else {
                     1.0
                 };
-                l += f * (w / p);
+                l += f * (w / (n as f32 * p));
             }
         }
         if self.with_bsdf {
@@ -96,7 +107,8 @@ impl DirectLighting for LearnedStrategy {
             {
                 let p_light = sel.pmf(&state, sp, b.light)
                     * scene.lights[b.light as usize].pdf(x, b.point, b.normal);
-                l += b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf);
+                let w = power_heuristic(1, &[(n as f32, p_light), (1.0, b.pdf)]);
+                l += b.f_cos * b.radiance * (w / b.pdf);
             }
         }
         l
