@@ -125,15 +125,17 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
             "cut": "breadth-first",
             "learned": opts.learned,
         }),
-        "oracle" => json!({
-            "defensive_power_fraction": oracle::DEFENSIVE,
-            "strata_per_side": oracle::STRATA_PER_SIDE,
-        }),
-        "oracle-shadowed" => json!({
-            "defensive_power_fraction": oracle::DEFENSIVE,
-            "strata_per_side": oracle::STRATA_PER_SIDE,
-            "shadowed": true,
-        }),
+        "oracle" | "oracle-shadowed" => {
+            let mut p = json!({
+                "defensive_power_fraction": oracle::DEFENSIVE,
+                "strata_per_side": oracle::STRATA_PER_SIDE,
+            });
+            // Only the new variant names it, so that the oracle's parameters stay as they were.
+            if name == "oracle-shadowed" {
+                p["shadowed"] = json!(true);
+            }
+            p
+        }
         other if ris_count(other).is_some() => json!({
             "candidates": ris_count(other),
             "delta": opts.delta,

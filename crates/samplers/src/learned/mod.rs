@@ -1,8 +1,8 @@
 //! Learned cluster selection (issue 25, after Vévoda et al. 2018): which cluster of a fixed
 //! light-tree cut a shading point samples is weighed by what earlier passes observed of each
-//! cluster in the point's region (its contribution over its prior, or its visibility), with the unshadowed tree importance as the
-//! prior and a defensive share of the prior alone, so that every light the tree can reach
-//! stays reachable.
+//! cluster in the point's region (its contribution over its prior, or its visibility), with the
+//! unshadowed tree importance as the prior and a defensive share of the prior alone, so that
+//! every light the tree can reach stays reachable.
 //!
 //! * `regions.rs`: the hash grid of regions (position cell × normal bucket), the per-region
 //!   tallies, and the observation a sample leaves in its pixel's memory;

@@ -142,25 +142,26 @@ impl LearnedSelection {
         let mut w = [0.0f32; MAX_CLUSTERS];
         // The cut's importances in one batch: its nodes are sorted by DFS id, so siblings sit
         // side by side and two pairs (four nodes) go through each evaluation.
-        let mut priors = [0.0f32; MAX_CLUSTERS];
         let (x, n) = state.tree.receiver();
-        lt.importances(&self.cut.nodes[..k], x, n, &mut priors[..k]);
+        lt.importances(&self.cut.nodes[..k], x, n, &mut state.prior[..k]);
         let contribution = self.config.target == LearnTarget::Contribution;
         // The region's mean ratio over every cluster: what a cluster not yet observed there is
         // expected to have (1 before any ray, which leaves the prior as it is).
-        let mean_ratio = region.map_or(1.0, |r| {
-            let (sum, rays) = r.iter().fold((0.0f64, 0u64), |(s, n), t| {
-                (s + t.ratio_sum as f64, n + t.rays as u64)
-            });
-            if rays > 0 && sum > 0.0 {
-                (sum / rays as f64) as f32
-            } else {
-                1.0
+        let mean_ratio = match region {
+            Some(r) if contribution => {
+                let (sum, rays) = r.iter().fold((0.0f64, 0u64), |(s, n), t| {
+                    (s + t.ratio_sum as f64, n + t.rays as u64)
+                });
+                if rays > 0 && sum > 0.0 {
+                    (sum / rays as f64) as f32
+                } else {
+                    1.0
+                }
             }
-        });
+            _ => 1.0,
+        };
         for c in 0..k {
-            let prior = sanitize(priors[c]);
-            state.q[c] = prior;
+            let prior = sanitize(state.prior[c]);
             state.prior[c] = prior;
             let v = match region {
                 None => 1.0,
@@ -176,7 +177,7 @@ impl LearnedSelection {
             sum_w += w[c] as f64;
         }
         if !(sum_prior > 0.0) {
-            state.q[..k].iter_mut().for_each(|q| *q = 0.0);
+            // No cluster reachable: every q stays 0 and `total` 0.
             return state;
         }
         let alpha = self.config.defensive as f64;
@@ -187,7 +188,7 @@ impl LearnedSelection {
             } else {
                 0.0
             };
-            let q = (1.0 - alpha) * learned + alpha * state.q[c] as f64 / sum_prior;
+            let q = (1.0 - alpha) * learned + alpha * state.prior[c] as f64 / sum_prior;
             state.q[c] = q as f32;
             total += state.q[c] as f64;
         }

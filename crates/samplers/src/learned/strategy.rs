@@ -1,6 +1,6 @@
-//! Strategies `learned` and `learned+bsdf`: one light by the learned cluster selection (±
-//! one BSDF sample, power heuristic), each light sample leaving its visibility in the
-//! pixel's memory for the merge between passes.
+//! Strategies `learned` and `learned+bsdf`: N lights by the learned cluster selection (one by
+//! default; ± one BSDF sample, power heuristic with counts), the first light sample leaving
+//! its observation in the pixel's memory for the merge between passes.
 use super::regions::{Observation, SLOTS};
 use super::selection::{LearnedSelection, sample_observed};
 use crate::bsdf_sampling::sample_bsdf;
@@ -71,7 +71,8 @@ impl DirectLighting for LearnedStrategy {
         let mut picks = Pooled::<Picks>::take();
         let x = sp.point();
         let mut l = Vec3::ZERO;
-        let n = sel.config.light_samples.max(1);
+        // At least 1: `LearnedSelection::new` refuses 0.
+        let n = sel.config.light_samples;
         // Where the second and later samples' observations go (one is learnt per pass).
         let mut unlearnt = [0.0f32; SLOTS];
         for i in 0..n {
