@@ -33,6 +33,17 @@ pub fn physical_memory_bytes() -> Option<u64> {
     }
 }
 
+/// Let a closed stdout end the process quietly, as it ends `ls` or `cat` (`manylights scenes |
+/// head`): Rust ignores SIGPIPE, so a write to a closed pipe fails and `println!` panics.
+/// Restores the default action (terminate) on Unix; elsewhere does nothing.
+pub fn exit_quietly_on_closed_pipe() {
+    #[cfg(unix)]
+    // SAFETY: setting a signal's disposition to its default touches no memory of ours.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
+    }
+}
+
 #[derive(Clone, Copy)]
 enum Clock {
     Process,

@@ -79,6 +79,7 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    host::exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(args),

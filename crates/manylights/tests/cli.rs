@@ -271,6 +271,23 @@ fn info_and_scenes_list() {
     );
 }
 
+/// A reader that stops early (`manylights scenes | head -1`) ends the listing quietly: no panic
+/// message about a broken pipe.
+#[test]
+fn closed_stdout_ends_quietly() {
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .arg("scenes")
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("panicked"), "{err}");
+}
+
 #[test]
 fn compare_reports_error_against_a_reference() {
     let dir = temp_dir("compare");
