@@ -123,7 +123,13 @@ fn kept_pixels(scene: &Scene, w: u32, h: u32, g: &Grid) -> Result<Vec<bool>, Str
                         scene.materials[m as usize].params_at(hit.uv).alpha < g.max_alpha
                     })
                 });
-                sees_light[i] |= hit.is_some_and(|hit| hit.light != NO_LIGHT);
+                // Seeing a light as the render's light mask does: an emitter hit from its
+                // emitting side (a one-sided emitter seen from behind is dark).
+                sees_light[i] |= hit.is_some_and(|hit| {
+                    hit.light != NO_LIGHT
+                        && scene.lights[hit.light as usize].emitted(hit.ng, hit.uv, -dir)
+                            != render_core::Vec3::ZERO
+                });
             }
         }
     }
