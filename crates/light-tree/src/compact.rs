@@ -17,6 +17,7 @@
 //! importance).
 
 use crate::lanes::{Fast, Lanes};
+use crate::quad::QuadNode;
 use crate::{BuildError, FLAG_HALF_SPACE, FLAG_TWO_SIDED, LightTree, Node, NodeExtra};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -142,13 +143,13 @@ fn decode_cos(c: i16) -> f32 {
 }
 
 /// One child's compact bounds, before it is placed in its pair.
-struct Slot {
-    qbox: [u16; 6],
-    axis: [i16; 3],
-    cos_o: i16,
-    cos_e: i16,
-    power: f32,
-    flags: u8,
+pub(crate) struct Slot {
+    pub(crate) qbox: [u16; 6],
+    pub(crate) axis: [i16; 3],
+    pub(crate) cos_o: i16,
+    pub(crate) cos_e: i16,
+    pub(crate) power: f32,
+    pub(crate) flags: u8,
 }
 
 /// The compact bounds of `node`: see the module docs for the rounding.
@@ -220,6 +221,10 @@ pub(crate) struct Compact {
     pub(crate) slot_of: Vec<u32>,
     /// Per pair: the node whose children it holds (`NodeId::MAX` for pair 0, the root's).
     pub(crate) parent: Vec<u32>,
+    /// The four-wide nodes the descents read (`quad.rs`).
+    pub(crate) quads: Vec<QuadNode>,
+    /// Per node: its quad, `u32::MAX` for leaves and odd-depth nodes.
+    pub(crate) quad_of: Vec<u32>,
 }
 
 impl Compact {
@@ -261,11 +266,14 @@ impl Compact {
                 }
             }
         }
+        let (quads, quad_of) = crate::quad::build(nodes, &slots);
         Ok(Compact {
             quant,
             pairs,
             slot_of,
             parent,
+            quads,
+            quad_of,
         })
     }
 }
@@ -278,10 +286,56 @@ pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec
     [v[0], v[1]]
 }
 
-/// The compact importances of two pairs at once, `[a.left, a.right, b.left, b.right]`: the
-/// exact importance's formula, term for term, on the decoded bounds, with selects instead of
-/// early exits. Each lane only sees its own node, so a node's value is the same bits in either
-/// pair position and in [`pair_importance`].
+/// Four compact slots, lane by lane: two node pairs side by side ([`NodePair`]), or one
+/// [`crate::quad::QuadNode`].
+pub(crate) trait FourSlots {
+    /// Box codes on row `k` (lower x, y, z, then upper x, y, z).
+    fn qbox(&self, k: usize) -> [u16; 4];
+    /// Axis codes on component `k`.
+    fn axis(&self, k: usize) -> [i16; 4];
+    fn cos_o(&self) -> [i16; 4];
+    fn cos_e(&self) -> [i16; 4];
+    fn power(&self) -> [f32; 4];
+    fn flags(&self) -> [u8; 4];
+}
+
+/// Two pairs as four slots: `[a.left, a.right, b.left, b.right]`.
+pub(crate) struct TwoPairs<'a>(pub(crate) &'a NodePair, pub(crate) &'a NodePair);
+
+impl FourSlots for TwoPairs<'_> {
+    #[inline(always)]
+    fn qbox(&self, k: usize) -> [u16; 4] {
+        let (a, b) = (self.0.qbox[k], self.1.qbox[k]);
+        [a[0], a[1], b[0], b[1]]
+    }
+    #[inline(always)]
+    fn axis(&self, k: usize) -> [i16; 4] {
+        let (a, b) = (self.0.axis[k], self.1.axis[k]);
+        [a[0], a[1], b[0], b[1]]
+    }
+    #[inline(always)]
+    fn cos_o(&self) -> [i16; 4] {
+        let (a, b) = (self.0.cos_o, self.1.cos_o);
+        [a[0], a[1], b[0], b[1]]
+    }
+    #[inline(always)]
+    fn cos_e(&self) -> [i16; 4] {
+        let (a, b) = (self.0.cos_e, self.1.cos_e);
+        [a[0], a[1], b[0], b[1]]
+    }
+    #[inline(always)]
+    fn power(&self) -> [f32; 4] {
+        let (a, b) = (self.0.power, self.1.power);
+        [a[0], a[1], b[0], b[1]]
+    }
+    #[inline(always)]
+    fn flags(&self) -> [u8; 4] {
+        let (a, b) = (self.0.flags, self.1.flags);
+        [a[0], a[1], b[0], b[1]]
+    }
+}
+
+/// The compact importances of two pairs at once, `[a.left, a.right, b.left, b.right]`.
 #[inline(always)]
 pub(crate) fn quad_importance<L: Lanes>(
     a: &NodePair,
@@ -290,16 +344,27 @@ pub(crate) fn quad_importance<L: Lanes>(
     x: Vec3,
     n: Vec3,
 ) -> [f32; 4] {
-    let code = |ca: [u16; 2], cb: [u16; 2]| {
-        L::quad(ca[0] as f32, ca[1] as f32, cb[0] as f32, cb[1] as f32)
-    };
+    slots_importance::<L, _>(&TwoPairs(a, b), q, x, n)
+}
+
+/// The compact importances of four slots: the exact importance's formula, term for term, on
+/// the decoded bounds, with selects instead of early exits. Each lane only sees its own node,
+/// so a node's value is the same bits in any slot of any pair or quad.
+#[inline(always)]
+pub(crate) fn slots_importance<L: Lanes, S: FourSlots>(
+    s: &S,
+    q: &Quant,
+    x: Vec3,
+    n: Vec3,
+) -> [f32; 4] {
+    let code = |c: [u16; 4]| L::quad(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32);
     let half_l = L::splat(0.5);
     let mut c = [L::splat(0.0); 3];
     let mut h = [L::splat(0.0); 3];
     for k in 0..3 {
-        let (o, s) = (L::splat(q.origin[k]), L::splat(q.step[k]));
-        let lo = o + code(a.qbox[k], b.qbox[k]) * s;
-        let hi = o + code(a.qbox[k + 3], b.qbox[k + 3]) * s;
+        let (o, st) = (L::splat(q.origin[k]), L::splat(q.step[k]));
+        let lo = o + code(s.qbox(k)) * st;
+        let hi = o + code(s.qbox(k + 3)) * st;
         c[k] = (lo + hi) * half_l - L::splat(x[k]);
         h[k] = (hi - lo) * half_l;
     }
@@ -308,23 +373,17 @@ pub(crate) fn quad_importance<L: Lanes>(
     let one = L::splat(1.0);
 
     let ax = [0, 1, 2].map(|k| {
-        let (u, v) = (a.axis[k], b.axis[k]);
-        L::quad(u[0] as f32, u[1] as f32, v[0] as f32, v[1] as f32)
+        let u = s.axis(k);
+        L::quad(u[0] as f32, u[1] as f32, u[2] as f32, u[3] as f32)
     });
-    let flag = |f: u8| {
-        L::mask([
-            a.flags[0] & f != 0,
-            a.flags[1] & f != 0,
-            b.flags[0] & f != 0,
-            b.flags[1] & f != 0,
-        ])
-    };
-    let cosines = |u: [i16; 2], v: [i16; 2]| {
+    let flags = s.flags();
+    let flag = |f: u8| L::mask(flags.map(|v| v & f != 0));
+    let cosines = |u: [i16; 4]| {
         L::quad(
             decode_cos(u[0]),
             decode_cos(u[1]),
-            decode_cos(v[0]),
-            decode_cos(v[1]),
+            decode_cos(u[2]),
+            decode_cos(u[3]),
         )
     };
     let inv_len = one / dot3(&ax, &ax).sqrt();
@@ -360,8 +419,8 @@ pub(crate) fn quad_importance<L: Lanes>(
     let two_sided = flag(FLAG_TWO_SIDED);
     cos_t = L::select(two_sided, cos_t.abs(), cos_t);
     let sin_t = (one - cos_t * cos_t).max(zero).sqrt();
-    let cos_o = cosines(a.cos_o, b.cos_o);
-    let cos_e = cosines(a.cos_e, b.cos_e);
+    let cos_o = cosines(s.cos_o());
+    let cos_e = cosines(s.cos_e());
     let sin_o = (one - cos_o * cos_o).max(zero).sqrt();
     let within = cos_t.ge(cos_o);
     let cos_x = L::select(within, one, cos_t * cos_o + sin_t * sin_o);
@@ -381,7 +440,8 @@ pub(crate) fn quad_importance<L: Lanes>(
         one
     };
 
-    let power = L::quad(a.power[0], a.power[1], b.power[0], b.power[1]);
+    let pw = s.power();
+    let power = L::quad(pw[0], pw[1], pw[2], pw[3]);
     let outside = power * emit * recv / d2c;
     let value = L::select(inside, power / d2c, cone_dark.andnot(outside));
     dark.andnot(value).out()
@@ -400,6 +460,13 @@ impl LightTree {
     pub(crate) fn quad_importances(&self, a: u32, b: u32, x: Vec3, n: Vec3) -> [f32; 4] {
         let c = &self.compact;
         quad_importance::<Fast>(&c.pairs[a as usize], &c.pairs[b as usize], &c.quant, x, n)
+    }
+
+    /// Compact importances of the four lanes of quad `quad`.
+    #[inline(always)]
+    pub(crate) fn quad_node_importances(&self, quad: u32, x: Vec3, n: Vec3) -> [f32; 4] {
+        let c = &self.compact;
+        slots_importance::<Fast, _>(&c.quads[quad as usize], &c.quant, x, n)
     }
 
     /// Index of the pair that holds `node`'s children; `None` for a leaf.

@@ -1,10 +1,10 @@
-//! Tests of the compact node pairs: bounds rounded outward, the compact importance positive
-//! wherever the exact one is and close to it, both lane implementations bit-identical, and
-//! the compact descents equal to the generic ones bit for bit.
+//! Tests of the compact node pairs and quads: bounds rounded outward, the compact importance
+//! positive wherever the exact one is and close to it, both lane implementations
+//! bit-identical, and the compact descents equal to the generic ones bit for bit.
 
-use crate::compact::{pair_importance, quad_importance};
+use crate::compact::{LEAF_BIT, pair_importance, quad_importance, slots_importance};
 use crate::lanes::{Fast, Scalar4};
-use crate::tests::{Layout, rand_lights, rand_receiver, tree_configs};
+use crate::tests::{Layout, four_wide_importance, rand_lights, rand_receiver, tree_configs};
 use crate::{LightTree, NodeId, Rescaled};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
@@ -117,9 +117,63 @@ fn lane_implementations_agree() {
     }
 }
 
+/// Every even-depth interior node has a quad whose lanes are its grandchildren (a leaf child
+/// in the first lane of its half, beside an empty lane of importance 0), each lane the same
+/// bits as `importance` of its node on both lane implementations, with the right codes.
+#[test]
+fn quads_hold_the_grandchildren() {
+    let mut rng = Pcg32::seed_from_u64(46);
+    for (tree, _) in trees(&mut rng) {
+        let c = &tree.compact;
+        let code = |id: NodeId| match tree.node(id).light() {
+            Some(l) => LEAF_BIT | l as u32,
+            None => c.quad_of[id as usize],
+        };
+        for _ in 0..10 {
+            let (x, n) = rand_receiver(&mut rng);
+            for id in 0..tree.nodes().len() as NodeId {
+                let node = tree.node(id);
+                let q = c.quad_of[id as usize];
+                let Some((l, r)) = node.children(id) else {
+                    assert_eq!(q, u32::MAX);
+                    continue;
+                };
+                if node.depth() % 2 == 1 {
+                    assert_eq!(q, u32::MAX);
+                    continue;
+                }
+                let quad = &c.quads[q as usize];
+                let fast = slots_importance::<Fast, _>(quad, &c.quant, x, n);
+                let portable = slots_importance::<Scalar4, _>(quad, &c.quant, x, n);
+                assert_eq!(fast.map(f32::to_bits), portable.map(f32::to_bits));
+                for (half, child) in [(0, l), (1, r)] {
+                    let lanes: [Option<NodeId>; 2] = match tree.node(child).children(child) {
+                        Some((a, b)) => [Some(a), Some(b)],
+                        None => [Some(child), None],
+                    };
+                    for (k, lane) in lanes.into_iter().enumerate() {
+                        let i = 2 * half + k;
+                        match lane {
+                            Some(g) => {
+                                assert_eq!(fast[i].to_bits(), tree.importance(g, x, n).to_bits());
+                                assert_eq!(quad.child[i], code(g));
+                            }
+                            None => {
+                                assert_eq!(fast[i], 0.0);
+                                assert_eq!(quad.child[i], LEAF_BIT);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// `sample_from` / `pmf_from` equal `sample_subtree` / `pmf_subtree` under
-/// `LightTree::importance`, bit for bit, from random start nodes; `child_importances` equals
-/// the two `importance` calls.
+/// `LightTree::importance` with each odd-depth interior node weighed as the sum of its
+/// children's (the four-wide descent, `quad.rs`), bit for bit, from random start nodes;
+/// `child_importances` equals the two `importance` calls.
 #[test]
 fn compact_descent_matches_the_generic_one() {
     let mut rng = Pcg32::seed_from_u64(44);
@@ -128,6 +182,7 @@ fn compact_descent_matches_the_generic_one() {
             let (x, n) = rand_receiver(&mut rng);
             let start = rng.random_range(0..tree.nodes().len() as NodeId);
             let imp = |c| tree.importance(c, x, n);
+            let four_wide = |c| four_wide_importance(&tree, c, x, n);
             if let Some((l, r)) = tree.node(start).children(start) {
                 let ci = tree.child_importances(start, x, n).unwrap();
                 assert_eq!(ci.map(f32::to_bits), [imp(l).to_bits(), imp(r).to_bits()]);
@@ -150,7 +205,7 @@ fn compact_descent_matches_the_generic_one() {
             }
             let u = rng.random::<u64>();
             let a = tree.sample_from(start, x, n, &mut Rescaled(u));
-            let b = tree.sample_subtree(start, imp, &mut Rescaled(u));
+            let b = tree.sample_subtree(start, four_wide, &mut Rescaled(u));
             assert_eq!(
                 a.map(|(l, p)| (l, p.to_bits())),
                 b.map(|(l, p)| (l, p.to_bits()))
@@ -161,7 +216,7 @@ fn compact_descent_matches_the_generic_one() {
             for light in 0..tree.num_lights().min(64) {
                 assert_eq!(
                     tree.pmf_from(start, x, n, light).to_bits(),
-                    tree.pmf_subtree(start, imp, light).to_bits()
+                    tree.pmf_subtree(start, four_wide, light).to_bits()
                 );
             }
         }

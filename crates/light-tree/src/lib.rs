@@ -73,6 +73,7 @@ mod compact;
 mod compact_tests;
 mod cone;
 mod lanes;
+mod quad;
 mod query;
 mod sg;
 #[cfg(test)]

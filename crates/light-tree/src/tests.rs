@@ -108,6 +108,19 @@ pub(crate) fn rand_receiver(rng: &mut impl Rng) -> (Vec3, Vec3) {
 
 /// Reference distribution of a descent from `start` by top-down propagation:
 /// (probability per light, mass lost in dead ends).
+/// The node weights of the four-wide descent (`LightTree::sample`): `importance`, except that
+/// an interior node at odd depth weighs as the sum of its children's (sanitised).
+pub(crate) fn four_wide_importance(tree: &LightTree, id: NodeId, x: Vec3, n: Vec3) -> f32 {
+    let node = tree.node(id);
+    match node.children(id) {
+        Some((l, r)) if node.depth() % 2 == 1 => {
+            crate::query::sanitize(tree.importance(l, x, n))
+                + crate::query::sanitize(tree.importance(r, x, n))
+        }
+        _ => tree.importance(id, x, n),
+    }
+}
+
 fn reference_pmf(tree: &LightTree, start: NodeId, imp: &dyn Fn(NodeId) -> f32) -> (Vec<f64>, f64) {
     let mut probs = vec![0.0f64; tree.num_lights()];
     let mut dead = 0.0f64;
@@ -303,7 +316,7 @@ fn pmf_sums_to_one_and_matches_sample() {
             let tree = LightTree::build(&lights).unwrap();
             for _ in 0..10 {
                 let (x, nrm) = rand_receiver(&mut rng);
-                let imp = |id| tree.importance(id, x, nrm);
+                let imp = |id| four_wide_importance(&tree, id, x, nrm);
                 let (reference, dead) = reference_pmf(&tree, tree.root(), &imp);
                 let pmfs: Vec<f32> = (0..n).map(|l| tree.pmf(x, nrm, l)).collect();
                 let sum: f64 = pmfs.iter().map(|&p| p as f64).sum();

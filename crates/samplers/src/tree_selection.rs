@@ -89,9 +89,8 @@ crate::scratch_pool!(TreeScratch, |s| {
 
 /// The E&K cut of one shading point (none for a single descent), in per-thread scratch.
 ///
-/// The picks and pmf replays descend the tree's compact node pairs
-/// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per level for
-/// both children. No memo: on `builtin:emissive-mesh` only 338 of 9,724 shading points
+/// The picks and pmf replays descend the tree's four-wide quads
+/// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per two levels. No memo: on `builtin:emissive-mesh` only 338 of 9,724 shading points
 /// replayed a pmf (callgrind, docs/light-tree.md), so its lookups cost more than they saved.
 pub struct TreeState {
     scratch: Pooled<TreeScratch>,
