@@ -188,6 +188,11 @@ impl SptdLobe {
     pub fn transformed_hemisphere(&self) -> Cap {
         self.th.to32()
     }
+    /// The factor of g(ω) in front of the pivot Jacobian: g(ω) = this ·
+    /// ((1 − |r|²)/|ω − r|²)² on H, for callers that evaluate g in their own lanes.
+    pub fn density_scale(&self) -> f64 {
+        self.scale
+    }
     /// The approximating density g(ω) on H (zero below it).
     pub fn density(&self, w: Vec3) -> f32 {
         if w.z <= 0.0 {

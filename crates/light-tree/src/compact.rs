@@ -225,6 +225,8 @@ pub(crate) struct Compact {
     pub(crate) quads: Vec<QuadNode>,
     /// Per node: its quad, `u32::MAX` for leaves and odd-depth nodes.
     pub(crate) quad_of: Vec<u32>,
+    /// Per quad: the nodes in its lanes (`NO_NODE` for an empty one), for caller weights.
+    pub(crate) quad_nodes: Vec<[crate::NodeId; 4]>,
 }
 
 impl Compact {
@@ -266,7 +268,7 @@ impl Compact {
                 }
             }
         }
-        let (quads, quad_of) = crate::quad::build(nodes, &slots);
+        let (quads, quad_of, quad_nodes) = crate::quad::build(nodes, &slots);
         Ok(Compact {
             quant,
             pairs,
@@ -274,6 +276,7 @@ impl Compact {
             parent,
             quads,
             quad_of,
+            quad_nodes,
         })
     }
 }

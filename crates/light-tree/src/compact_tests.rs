@@ -257,3 +257,58 @@ fn batched_importances_match_one_call_per_node() {
         }
     }
 }
+
+/// `sample_quads` / `pmf_quads` under a caller's weight equal `sample_subtree` /
+/// `pmf_subtree` under the same weight with each odd-depth interior node weighed as the sum of
+/// its children's (sanitised), bit for bit, from random start nodes; the weight sees each
+/// quad's own nodes, and its empty lanes count as 0 whatever it returns there.
+#[test]
+fn caller_weighted_quad_descent_matches_the_generic_one() {
+    let mut rng = Pcg32::seed_from_u64(46);
+    // An arbitrary deterministic weight with zeros, NaN and infinities among its values.
+    let weight = |id: NodeId| match (id as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 59 {
+        0 => 0.0,
+        1 => f32::NAN,
+        2 => f32::INFINITY,
+        k => (k as f32).powi(3) * 1e-3, // k < 32
+    };
+    for (tree, _) in trees(&mut rng) {
+        let binary = |id: NodeId| {
+            let node = tree.node(id);
+            match node.children(id) {
+                Some((l, r)) if node.depth() % 2 == 1 => {
+                    crate::query::sanitize(weight(l)) + crate::query::sanitize(weight(r))
+                }
+                _ => weight(id),
+            }
+        };
+        let mut lanes = |quad: Option<u32>, nodes: &[NodeId; 4]| {
+            if let Some(q) = quad {
+                assert_eq!(tree.quad_nodes(q), nodes);
+            }
+            nodes.map(|id| {
+                if id == crate::NO_NODE {
+                    7.0
+                } else {
+                    weight(id)
+                }
+            })
+        };
+        for _ in 0..200 {
+            let start = rng.random_range(0..tree.nodes().len() as NodeId);
+            let u = rng.random::<u64>();
+            let a = tree.sample_quads(start, &mut lanes, &mut Rescaled(u));
+            let b = tree.sample_subtree(start, binary, &mut Rescaled(u));
+            assert_eq!(
+                a.map(|(l, p)| (l, p.to_bits())),
+                b.map(|(l, p)| (l, p.to_bits()))
+            );
+            for light in 0..tree.num_lights().min(64) {
+                assert_eq!(
+                    tree.pmf_quads(start, &mut lanes, light).to_bits(),
+                    tree.pmf_subtree(start, binary, light).to_bits()
+                );
+            }
+        }
+    }
+}

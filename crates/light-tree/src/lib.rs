@@ -74,6 +74,7 @@ mod compact_tests;
 mod cone;
 mod lanes;
 mod quad;
+mod quad_descent;
 mod query;
 mod sg;
 #[cfg(test)]
@@ -84,6 +85,7 @@ mod split_tests;
 mod tests;
 
 pub use cone::Cone;
+pub use quad_descent::{NO_NODE, QuadWeights};
 pub use query::{Cut, DescentRandom, Fresh, Rescaled, SplitCriterion, SplitParams};
 pub use sg::{
     SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,
@@ -354,6 +356,12 @@ impl Node {
     #[inline]
     pub fn two_sided(&self) -> bool {
         self.flags & FLAG_TWO_SIDED != 0
+    }
+    /// The subtree's emission stays within π/2 of the axis even with θo + θe, so a receiver
+    /// behind the whole box gets nothing.
+    #[inline]
+    pub fn half_space(&self) -> bool {
+        self.flags & FLAG_HALF_SPACE != 0
     }
     /// Children `(left, right)` of an interior node, given the node's own id.
     #[inline]

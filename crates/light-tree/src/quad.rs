@@ -10,7 +10,7 @@
 //! the sum of its children's importances (see `compact_tests.rs`).
 
 use crate::compact::{FourSlots, LEAF_BIT, Slot};
-use crate::{Node, NodeId};
+use crate::{NO_NODE, Node, NodeId};
 
 /// Four slots, structure-of-arrays, lanes `[left.l, left.r, right.l, right.r]`; 128 bytes.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -76,9 +76,9 @@ impl FourSlots for QuadNode {
     }
 }
 
-/// The quads of a tree and, per node, the index of its quad (`u32::MAX`: none, i.e. a leaf
-/// or an odd-depth node).
-pub(crate) fn build(nodes: &[Node], slots: &[Slot]) -> (Vec<QuadNode>, Vec<u32>) {
+/// The quads of a tree, per node the index of its quad (`u32::MAX`: none, i.e. a leaf or an
+/// odd-depth node), and per quad the nodes in its lanes (`NO_NODE` where empty).
+pub(crate) fn build(nodes: &[Node], slots: &[Slot]) -> (Vec<QuadNode>, Vec<u32>, Vec<[NodeId; 4]>) {
     let mut quad_of = vec![u32::MAX; nodes.len()];
     let mut count = 0u32;
     for (id, node) in nodes.iter().enumerate() {
@@ -92,6 +92,7 @@ pub(crate) fn build(nodes: &[Node], slots: &[Slot]) -> (Vec<QuadNode>, Vec<u32>)
         None => quad_of[id as usize],
     };
     let mut quads = vec![QuadNode::default(); count as usize];
+    let mut lanes = vec![[NO_NODE; 4]; count as usize];
     for (id, node) in nodes.iter().enumerate() {
         let q = quad_of[id];
         if q == u32::MAX {
@@ -106,13 +107,16 @@ pub(crate) fn build(nodes: &[Node], slots: &[Slot]) -> (Vec<QuadNode>, Vec<u32>)
                 Some((cl, cr)) => {
                     quad.set(2 * half, &slots[cl as usize], code(cl));
                     quad.set(2 * half + 1, &slots[cr as usize], code(cr));
+                    lanes[q as usize][2 * half] = cl;
+                    lanes[q as usize][2 * half + 1] = cr;
                 }
                 None => {
                     quad.set(2 * half, &slots[c as usize], code(c));
                     quad.set_empty(2 * half + 1);
+                    lanes[q as usize][2 * half] = c;
                 }
             }
         }
     }
-    (quads, quad_of)
+    (quads, quad_of, lanes)
 }

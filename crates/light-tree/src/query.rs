@@ -1,6 +1,7 @@
 //! Queries: node importance, stochastic descent and its pmf replay, cuts.
 
 use crate::compact::LEAF_BIT;
+use crate::quad_descent::StepWeights;
 use crate::{LightTree, Node, NodeId};
 use glam::Vec3;
 use std::collections::VecDeque;
@@ -108,7 +109,7 @@ fn sin_sub_clamped(cos_a: f32, sin_a: f32, cos_b: f32, sin_b: f32) -> f32 {
 /// the step's probability)`, or `None` when both are 0. A child of importance 0 is never taken
 /// and consumes no random number. `pmf_subtree` and `pmf_from` replay the same quotients.
 #[inline(always)]
-fn choose<R: DescentRandom>(il: f32, ir: f32, rng: &mut R) -> Option<(bool, f32)> {
+pub(crate) fn choose<R: DescentRandom>(il: f32, ir: f32, rng: &mut R) -> Option<(bool, f32)> {
     let sum = il + ir;
     if sum == 0.0 {
         return None;
@@ -122,6 +123,23 @@ fn choose<R: DescentRandom>(il: f32, ir: f32, rng: &mut R) -> Option<(bool, f32)
         rng.go_left(pl)
     };
     Some(if left { (true, pl) } else { (false, ir / sum) })
+}
+
+/// The four-wide descent's lanes under the tree's compact E&K importance at (x, n).
+struct EkLanes {
+    x: Vec3,
+    n: Vec3,
+}
+
+impl StepWeights for EkLanes {
+    #[inline(always)]
+    fn pair(&mut self, tree: &LightTree, _: NodeId, pair: u32) -> [f32; 2] {
+        tree.pair_importances(pair, self.x, self.n)
+    }
+    #[inline(always)]
+    fn quad(&mut self, tree: &LightTree, quad: u32) -> [f32; 4] {
+        tree.quad_node_importances(quad, self.x, self.n)
+    }
 }
 
 impl Node {
@@ -250,7 +268,7 @@ impl LightTree {
     /// Starts loading the quads `codes` (leaf codes are skipped), both lines of each: the
     /// candidates for the next step of a four-wide descent.
     #[inline(always)]
-    fn prefetch_quads(&self, codes: [u32; 4]) {
+    pub(crate) fn prefetch_quads(&self, codes: [u32; 4]) {
         #[cfg(target_arch = "x86_64")]
         {
             use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
@@ -492,120 +510,13 @@ impl LightTree {
         n: Vec3,
         rng: &mut R,
     ) -> Option<(usize, f32)> {
-        let node = &self.nodes[start as usize];
-        if node.is_leaf() {
-            return Some((node.child_or_light as usize, 1.0));
-        }
-        let mut pmf = 1.0f32;
-        let mut quad = if node.depth() % 2 == 0 {
-            self.compact.quad_of[start as usize]
-        } else {
-            let pair = self.children_pair(start)?;
-            let [il, ir] = self.pair_importances(pair, x, n).map(sanitize);
-            let (left, f) = choose(il, ir, rng)?;
-            pmf *= f;
-            let child = if left { start + 1 } else { node.child_or_light };
-            let c = &self.nodes[child as usize];
-            if c.is_leaf() {
-                return Some((c.child_or_light as usize, pmf));
-            }
-            self.compact.quad_of[child as usize]
-        };
-        let quads = &self.compact.quads;
-        loop {
-            let q = &quads[quad as usize];
-            self.prefetch_quads(q.child);
-            let g = self.quad_node_importances(quad, x, n).map(sanitize);
-            let (ia, ib) = (sanitize(g[0] + g[1]), sanitize(g[2] + g[3]));
-            let (left, f) = choose(ia, ib, rng)?;
-            pmf *= f;
-            let h = if left { 0 } else { 2 };
-            // A half of non-zero weight has a lane of non-zero importance. A leaf's half is
-            // (leaf, empty): its second choice is certain (1.0) and draws nothing. (Both
-            // decisions as nested intervals of the one number, rescaled once, measured 3-8 %
-            // slower than two rescales: the division is not what the step waits for.)
-            let (first, f) = choose(g[h], g[h + 1], rng)?;
-            pmf *= f;
-            let code = q.child[h + if first { 0 } else { 1 }];
-            if code & LEAF_BIT != 0 {
-                return Some(((code & !LEAF_BIT) as usize, pmf));
-            }
-            quad = code;
-        }
+        self.descend(start, &mut EkLanes { x, n }, rng)
     }
 
     /// Probability that [`LightTree::sample_from`] from `start` returns `light` (0 if `light`
     /// is not under `start`), replayed along its bit trail with the same operations.
     pub fn pmf_from(&self, start: NodeId, x: Vec3, n: Vec3, light: usize) -> f32 {
-        let leaf = self.leaf_of[light];
-        let (first, last) = self.subtree_range(start);
-        if leaf < first || leaf > last {
-            return 0.0;
-        }
-        let node = &self.nodes[start as usize];
-        if node.is_leaf() {
-            return 1.0;
-        }
-        let leaf_depth = self.nodes[leaf as usize].depth();
-        let mut depth = node.depth();
-        // `start` is interior here, so its depth is below 64.
-        let mut bits = self.trails[light] >> depth;
-        let step = |il: f32, ir: f32, side: u64| {
-            let (il, ir) = (sanitize(il), sanitize(ir));
-            let sum = il + ir;
-            (sum != 0.0).then(|| if side == 0 { il / sum } else { ir / sum })
-        };
-        let mut pmf = 1.0f32;
-        let mut quad = if depth % 2 == 0 {
-            self.compact.quad_of[start as usize]
-        } else {
-            let Some(pair) = self.children_pair(start) else {
-                return 0.0;
-            };
-            let [il, ir] = self.pair_importances(pair, x, n);
-            let Some(f) = step(il, ir, bits & 1) else {
-                return 0.0;
-            };
-            pmf *= f;
-            let child = if bits & 1 == 0 {
-                start + 1
-            } else {
-                node.child_or_light
-            };
-            if depth + 1 == leaf_depth {
-                return pmf;
-            }
-            bits >>= 1;
-            depth += 1;
-            self.compact.quad_of[child as usize]
-        };
-        let quads = &self.compact.quads;
-        loop {
-            let q = &quads[quad as usize];
-            let g = self.quad_node_importances(quad, x, n).map(sanitize);
-            let (ia, ib) = (sanitize(g[0] + g[1]), sanitize(g[2] + g[3]));
-            let Some(f) = step(ia, ib, bits & 1) else {
-                return 0.0;
-            };
-            pmf *= f;
-            let h = 2 * (bits & 1) as usize;
-            // The leaf is the child itself (first lane of its half) or one of its children.
-            let lane = if depth + 1 == leaf_depth {
-                0
-            } else {
-                (bits >> 1) & 1
-            };
-            let Some(f) = step(g[h], g[h + 1], lane) else {
-                return 0.0;
-            };
-            pmf *= f;
-            if depth + 2 >= leaf_depth {
-                return pmf;
-            }
-            quad = q.child[h + lane as usize];
-            bits >>= 2;
-            depth += 2;
-        }
+        self.replay(start, &mut EkLanes { x, n }, light)
     }
 
     /// Generic descent from `start`: at each interior node go left with probability

@@ -192,6 +192,10 @@ pub struct MethodArgs {
     /// paper, instead of one descent there (--reproduce implies it).
     #[arg(long)]
     pub split_ls_at_glossy: bool,
+    /// mis3 strategies and RIS: BO descends below its cut one binary level at a time, as the
+    /// paper, instead of the tree's four-wide descent (--reproduce implies it).
+    #[arg(long)]
+    pub binary_bo_descent: bool,
     /// Learned selection: what a region learns of each cluster, `contribution` (its observed
     /// contribution over its prior) or `visibility` (its shadow rays' hit rate).
     #[arg(long, default_value = LearnedConfig::default().target.name(),
@@ -306,6 +310,7 @@ impl MethodArgs {
             efficient_total: !self.fixed_n_max,
             stratified: !self.independent_samples,
             split_ls_at_glossy: self.split_ls_at_glossy,
+            binary_bo_descent: self.binary_bo_descent,
             learned: LearnedConfig {
                 target: self.learned_target,
                 clusters: self.learned_clusters,

@@ -89,6 +89,9 @@ pub struct StrategyOptions {
     /// paper does (and `reproduce`); off (our default): one descent from the root there, the
     /// cut stays at diffuse points.
     pub split_ls_at_glossy: bool,
+    /// BO descends below its cut one binary level at a time, as the paper, instead of the
+    /// tree's four-wide descent (`reproduce` and `--bo-importance sg` imply it).
+    pub binary_bo_descent: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
@@ -156,6 +159,7 @@ impl Default for StrategyOptions {
             efficient_total: true,
             stratified: true,
             split_ls_at_glossy: false,
+            binary_bo_descent: false,
             adaptive_split: true,
             learned: learned::LearnedConfig::default(),
         }

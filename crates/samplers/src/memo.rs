@@ -1,4 +1,5 @@
-//! A direct-mapped cache of per-node values (importances) of one shading point.
+//! A direct-mapped cache of per-node values (importances) of one shading point, or of
+//! per-quad values (the four lanes of a four-wide descent step, keyed by quad index).
 //!
 //! A node's importance is a pure function of (node, shading point), so a cached value is
 //! bit-identical to a recomputed one: sampling and every pdf replay see the same numbers
@@ -9,25 +10,31 @@ use light_tree::NodeId;
 const SLOTS: usize = 1024;
 
 #[derive(Clone, Copy)]
-struct Slot {
+struct Slot<V> {
     node: NodeId,
     stamp: u32,
-    value: f32,
+    value: V,
 }
 
-pub struct NodeMemo {
-    slots: Box<[Slot]>,
+/// The cache, of values `V` keyed by a node id (or a quad index).
+pub struct Memo<V> {
+    slots: Box<[Slot<V>]>,
     stamp: u32,
 }
 
-impl Default for NodeMemo {
-    fn default() -> NodeMemo {
-        NodeMemo {
+/// Node importances.
+pub type NodeMemo = Memo<f32>;
+/// The four lanes of a quad (`light_tree::LightTree::quad_nodes`), keyed by quad index.
+pub type QuadMemo = Memo<[f32; 4]>;
+
+impl<V: Copy + Default> Default for Memo<V> {
+    fn default() -> Memo<V> {
+        Memo {
             slots: vec![
                 Slot {
                     node: NodeId::MAX,
                     stamp: 0,
-                    value: 0.0
+                    value: V::default()
                 };
                 SLOTS
             ]
@@ -41,7 +48,7 @@ impl Default for NodeMemo {
 // pool too, so taking one does not allocate per shading point.
 crate::scratch_pool!(NodeMemo, |m| m.invalidate());
 
-impl NodeMemo {
+impl<V: Copy> Memo<V> {
     /// Forgets every cached value (a new shading point).
     pub fn invalidate(&mut self) {
         self.stamp = self.stamp.wrapping_add(1);
@@ -53,14 +60,14 @@ impl NodeMemo {
 
     /// The cached value of `node`, if any.
     #[inline]
-    pub fn get(&self, node: NodeId) -> Option<f32> {
+    pub fn get(&self, node: NodeId) -> Option<V> {
         let s = &self.slots[Self::slot(node)];
         (s.node == node && s.stamp == self.stamp).then_some(s.value)
     }
 
     /// Stores `value` for `node` (which must be what `compute` would give it).
     #[inline]
-    pub fn insert(&mut self, node: NodeId, value: f32) {
+    pub fn insert(&mut self, node: NodeId, value: V) {
         let stamp = self.stamp;
         self.slots[Self::slot(node)] = Slot { node, stamp, value };
     }
@@ -73,7 +80,7 @@ impl NodeMemo {
 
     /// The cached value of `node`, or `compute(node)` stored for next time.
     #[inline]
-    pub fn get_or(&mut self, node: NodeId, compute: impl FnOnce(NodeId) -> f32) -> f32 {
+    pub fn get_or(&mut self, node: NodeId, compute: impl FnOnce(NodeId) -> V) -> V {
         let slot = Self::slot(node);
         let stamp = self.stamp;
         let s = &mut self.slots[slot];

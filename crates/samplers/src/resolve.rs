@@ -3,7 +3,7 @@
 //! from the same functions, so what this reports is what they use; the render's JSON records
 //! it and the experiment harness keys its cells by it (a changed default re-renders the cells
 //! of exactly the strategies that use it).
-use crate::brdf_oriented::{BoConfig, BrdfIntegral};
+use crate::brdf_oriented::{BoConfig, BoImportance, BrdfIntegral};
 use crate::tree_selection::PowerUnits;
 use crate::{StrategyError, StrategyOptions, oracle, ris_count, strategies};
 use brdf_integrals::{Intersection, Lookup, Ltc, Normalization, Sptd};
@@ -29,6 +29,9 @@ pub fn bo_config(opts: &StrategyOptions) -> BoConfig {
         stratified: opts.stratified && !opts.reproduce,
         single_ls_at_glossy: !opts.split_ls_at_glossy && !opts.reproduce,
         adaptive_split: opts.adaptive_split,
+        four_wide_bo_descent: !opts.binary_bo_descent
+            && !opts.reproduce
+            && opts.bo_importance == BoImportance::Cap,
     }
 }
 

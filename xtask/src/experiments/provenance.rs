@@ -57,25 +57,33 @@ fn git(root: &Path, args: &[&str]) -> Option<String> {
         .then(|| String::from_utf8_lossy(&out.stdout).into_owned())
 }
 
+/// Files under [`CODE_PATHS`] that cannot change the binary: no crate includes a Markdown
+/// file (a crate's README is not its doc), so editing one during a run neither dirties the
+/// tree nor starts a new code state.
+const NOT_CODE: &str = ":(exclude,glob)**/*.md";
+
 /// The code state of a clean tree at `root` (HEAD and its `tree:` id); `None` when the tree
-/// is dirty under [`CODE_PATHS`] or not in git.
+/// is dirty under [`CODE_PATHS`] (Markdown aside) or not in git.
 pub fn clean_code_state(root: &Path) -> Option<CodeState> {
     let commit = git(root, &["rev-parse", "--short=12", "HEAD"])?
         .trim()
         .to_string();
     let mut status_args = vec!["status", "--porcelain", "--untracked-files=no", "--"];
     status_args.extend(CODE_PATHS);
+    status_args.push(NOT_CODE);
     if !git(root, &status_args)?.trim().is_empty() {
         return None;
     }
-    // HEAD:path for each path that exists at HEAD (.cargo may not).
-    let objects: Vec<String> = CODE_PATHS
-        .iter()
-        .filter_map(|p| git(root, &["rev-parse", &format!("HEAD:{p}")]))
-        .map(|s| s.trim().to_string())
+    // Every blob under the code paths at HEAD, with its path, Markdown aside.
+    let mut ls_args = vec!["ls-tree", "-r", "--full-tree", "HEAD", "--"];
+    ls_args.extend(CODE_PATHS);
+    let listing: String = git(root, &ls_args)?
+        .lines()
+        .filter(|line| !line.ends_with(".md"))
+        .flat_map(|line| [line, "\n"])
         .collect();
     Some(CodeState {
-        id: format!("tree:{}", hex_hash(objects.join(" ").as_bytes())),
+        id: format!("tree:{}", hex_hash(listing.as_bytes())),
         commit: Some(commit),
         dirty: false,
     })
@@ -359,5 +367,53 @@ mod tests {
             Freshness::of(&dirty, Some(&now)),
             Freshness::Mixed { states: 1 }
         );
+    }
+
+    /// A README under `crates/` is not code: editing it neither dirties the tree nor makes a
+    /// new code state; editing a source file does both.
+    #[test]
+    fn markdown_under_the_code_paths_is_not_code() {
+        let dir = std::env::temp_dir().join(format!("ml-provenance-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(dir.join("crates/a/src")).unwrap();
+        let run = |args: &[&str]| {
+            let ok = Command::new("git")
+                .args(["-c", "user.name=t", "-c", "user.email=t@t"])
+                .args(args)
+                .current_dir(&dir)
+                .output()
+                .map(|o| o.status.success())
+                .unwrap_or(false);
+            assert!(ok, "git {args:?}");
+        };
+        let write = |path: &str, text: &str| std::fs::write(dir.join(path), text).unwrap();
+        run(&["init", "-q"]);
+        write("crates/a/src/lib.rs", "fn a() {}");
+        write("crates/a/README.md", "one");
+        write("Cargo.toml", "[workspace]");
+        run(&["add", "."]);
+        run(&["commit", "-q", "-m", "one"]);
+        let first = clean_code_state(&dir).expect("a clean tree has a code state");
+
+        write("crates/a/README.md", "two");
+        let edited = clean_code_state(&dir).expect("an edited README leaves the tree clean");
+        assert_eq!(edited.id, first.id);
+        run(&["commit", "-q", "-am", "two"]);
+        let committed = clean_code_state(&dir).unwrap();
+        assert_eq!(
+            committed.id, first.id,
+            "a README commit is the same code state"
+        );
+        assert_ne!(committed.commit, first.commit);
+
+        write("crates/a/src/lib.rs", "fn b() {}");
+        assert_eq!(
+            clean_code_state(&dir),
+            None,
+            "an edited source file dirties the tree"
+        );
+        run(&["commit", "-q", "-am", "three"]);
+        assert_ne!(clean_code_state(&dir).unwrap().id, first.id);
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -11,6 +11,7 @@
 //! `reproduce` keeps the authors' glossy-only importance and Oat–Sander cap ∩ cap.
 use brdf_integrals::LobeIntegral;
 use brdf_integrals::cap::{Cap, intersection_area_exact, intersection_area_oat_sander};
+use glam::Vec4;
 use light_tree::Node;
 use render_core::Vec3;
 use render_core::colour::luminance;
@@ -44,17 +45,17 @@ pub struct BoRecord<L> {
     /// (see `point_estimate`); off in `reproduce`.
     pub point_approx: bool,
     /// The lobe's peak, precomputed for `point_estimate` (None without a peak).
-    peak: Option<PeakBound>,
+    pub(super) peak: Option<PeakBound>,
 }
 
 /// The lobe's peak direction and angular width w, with cos 3w and sin 3w, so that the test
 /// "the cap lies farther than 3w from the peak" needs no inverse trigonometry per node.
 #[derive(Clone, Copy, Debug)]
-struct PeakBound {
-    dir: Vec3,
-    width: f32,
-    cos3w: f32,
-    sin3w: f32,
+pub(super) struct PeakBound {
+    pub(super) dir: Vec3,
+    pub(super) width: f32,
+    pub(super) cos3w: f32,
+    pub(super) sin3w: f32,
 }
 
 /// A node's BO terms at a shading point.
@@ -74,6 +75,11 @@ pub trait LobeDensity {
     fn density(&self, w: Vec3) -> Option<f32>;
     /// The peak direction (local) and angular width in radians.
     fn peak(&self) -> Option<(Vec3, f32)>;
+    /// g at four local directions above the horizon, in f32 lanes (`quad_importance.rs`);
+    /// None where the method has no density.
+    fn density4(&self, _w: [Vec4; 3]) -> Option<Vec4> {
+        None
+    }
 }
 
 impl LobeDensity for brdf_integrals::SptdLobe {
@@ -86,6 +92,19 @@ impl LobeDensity for brdf_integrals::SptdLobe {
     fn peak(&self) -> Option<(Vec3, f32)> {
         let rho = self.pivot.length();
         (rho > 1e-3).then(|| (self.pivot / rho, (1.0 - rho).max(1e-4)))
+    }
+    /// The pivot Jacobian squared in f32 (the scalar `density` takes f64).
+    #[inline]
+    fn density4(&self, w: [Vec4; 3]) -> Option<Vec4> {
+        let p = self.pivot;
+        let num = Vec4::splat(1.0 - p.length_squared());
+        let [dx, dy, dz] = [
+            w[0] - Vec4::splat(p.x),
+            w[1] - Vec4::splat(p.y),
+            w[2] - Vec4::splat(p.z),
+        ];
+        let j = num / (dx * dx + dy * dy + dz * dz);
+        Some(Vec4::splat(self.density_scale() as f32) * j * j)
     }
 }
 

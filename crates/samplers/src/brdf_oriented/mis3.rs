@@ -100,14 +100,17 @@ where
         };
         let rec = BoRecord::new(sp, lobe, !self.config.reproduce, self.config.reproduce);
         let sg = self.sg_nodes.as_ref().map(|n| SgImportance::new(n, sp));
-        Some(BoState::with_importance(
-            tree,
-            rec,
-            sg,
-            self.config.delta,
-            self.config.max_cut_bo,
-            pivot,
-        ))
+        Some(
+            BoState::with_importance(
+                tree,
+                rec,
+                sg,
+                self.config.delta,
+                self.config.max_cut_bo,
+                pivot,
+            )
+            .with_four_wide_descent(self.config.four_wide_bo_descent),
+        )
     }
 }
 

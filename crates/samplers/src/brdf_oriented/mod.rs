@@ -7,6 +7,7 @@
 //! * [`technique`]: BO sampling and its pdf for any light point.
 //! * [`allocation`]: the two allocation heuristics and the unbiased fixed-count variant.
 //! * [`mis3`]: the strategies `brdf-oriented`, `mis3-equal`, `mis3-adaptive`.
+//! * [`quad_importance`]: I_BO of four nodes at once, for BO's four-wide descent.
 //! * [`pivot_sphere`]: optional pivot-transformed point sampling on sphere lights.
 //! * [`sg_importance`]: the SG node importance (Tokuyoshi et al. 2024) as BO's cluster and
 //!   descent importance (`--bo-importance sg`).
@@ -15,6 +16,7 @@ pub mod cut;
 pub mod importance;
 pub mod mis3;
 pub mod pivot_sphere;
+pub mod quad_importance;
 pub mod sg_importance;
 pub mod technique;
 pub mod three_techniques;
@@ -143,6 +145,10 @@ pub struct BoConfig {
     pub single_ls_at_glossy: bool,
     /// Heuristic 2 (P(BO) from hit/miss counts); off: P = 1/2.
     pub adaptive_split: bool,
+    /// BO's descent below its cut is the tree's four-wide one (two levels a step, I_BO of four
+    /// nodes at once); off (the authors' code, and under the SG importance): the binary one.
+    #[serde(default)]
+    pub four_wide_bo_descent: bool,
 }
 
 /// The SPTD pivot of a lobe, where the approximation has one.

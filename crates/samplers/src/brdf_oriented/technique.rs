@@ -5,25 +5,63 @@ use super::cut::{BoCut, BoCutScratch};
 use super::importance::{BoRecord, LobeDensity};
 use super::pivot_sphere::PivotSphere;
 use super::sg_importance::SgImportance;
-use crate::memo::NodeMemo;
+use crate::memo::{NodeMemo, QuadMemo};
 use crate::scratch::Pooled;
 use brdf_integrals::LobeIntegral;
-use light_tree::{Fresh, LightTree, NodeId, Rescaled};
+use light_tree::{DescentRandom, Fresh, LightTree, NO_NODE, NodeId, Rescaled};
 use render_core::Vec3;
 use render_core::light::{Light, LightSample};
 use render_core::rng::SampleStream;
 use std::cell::RefCell;
 
+/// 64 fresh random bits for every second decision, rescaled ([`Rescaled`]) for the one
+/// between: the four-wide descent's two decisions per step take one fresh number. After a
+/// decision the rescaled number is uniform again given that decision, so any sequence of
+/// decisions stays exact. A decision of probability p uses log₂(1/p) of the 64 bits, so the
+/// second one keeps at least 24 (what an f32 pmf resolves) unless the first had p < 2⁻⁴⁰.
+struct FreshPerStep<F: FnMut() -> u64> {
+    next: F,
+    u: Rescaled,
+    left: u8,
+}
+
+impl<F: FnMut() -> u64> FreshPerStep<F> {
+    fn new(next: F) -> Self {
+        FreshPerStep {
+            next,
+            u: Rescaled(0),
+            left: 0,
+        }
+    }
+}
+
+impl<F: FnMut() -> u64> DescentRandom for FreshPerStep<F> {
+    #[inline]
+    fn go_left(&mut self, p_left: f32) -> bool {
+        if self.left == 0 {
+            self.u = Rescaled((self.next)());
+            self.left = 2;
+        }
+        self.left -= 1;
+        self.u.go_left(p_left)
+    }
+}
+
 /// Per-thread buffers of one shading point's BO state: the cut, its build scratch and the
-/// importance memo.
+/// importance memos (per node for the binary descent and the pair steps, per quad for the
+/// four-wide descent).
 #[derive(Default)]
 pub struct BoScratch {
     cut: BoCut,
     build: BoCutScratch,
     memo: RefCell<NodeMemo>,
+    quads: RefCell<QuadMemo>,
 }
 
-crate::scratch_pool!(BoScratch, |s| s.memo.get_mut().invalidate());
+crate::scratch_pool!(BoScratch, |s| {
+    s.memo.get_mut().invalidate();
+    s.quads.get_mut().invalidate();
+});
 
 /// Per-shading-point BO state: the record, the BO cut with its cluster distribution, and the
 /// memoised node importances shared by sampling and pdf evaluation. Its buffers are on loan
@@ -37,6 +75,9 @@ pub struct BoState<'a, L> {
     pub pivot: Option<PivotSphere>,
     /// The SG importance that replaces I_BO in the cluster choice and the descent, if chosen.
     sg: Option<SgImportance<'a>>,
+    /// The descent below the cut is the tree's four-wide one (`LightTree::sample_quads`);
+    /// off: the binary one (`LightTree::sample_subtree`).
+    four_wide: bool,
 }
 
 impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
@@ -69,8 +110,16 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
             rec,
             scratch,
             pivot,
+            four_wide: sg.is_none(),
             sg,
         }
+    }
+
+    /// Chooses the descent below the cut: four-wide (the default without the SG importance)
+    /// or binary (the paper's, one level at a time). Sampling and every pmf replay use it.
+    pub fn with_four_wide_descent(mut self, four_wide: bool) -> Self {
+        self.four_wide = four_wide;
+        self
     }
 
     /// The BO cut: clusters (sorted DFS ids), their terms and the cluster cdf.
@@ -88,6 +137,47 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
                 Some(sg) => sg.importance(tree, id),
                 None => self.rec.terms(tree.node(id)).importance,
             })
+    }
+
+    /// The weights of one step of the four-wide descent: I_BO of the four nodes, in lanes
+    /// where it takes its point form (`quad_importance.rs`) and by the scalar terms
+    /// elsewhere (or the SG importance), memoised per quad (the pair step of an odd-depth
+    /// cluster root per node).
+    fn quad_lanes(&self, tree: &LightTree, quad: Option<u32>, nodes: &[NodeId; 4]) -> [f32; 4] {
+        let lanes = |nodes: &[NodeId; 4]| {
+            let point = match self.sg {
+                None => {
+                    // An empty lane (always after a real one) borrows the first node.
+                    let node = |id: NodeId| tree.node(if id == NO_NODE { nodes[0] } else { id });
+                    self.rec.point_importances(nodes.map(node))
+                }
+                Some(_) => [None; 4],
+            };
+            std::array::from_fn(|k| match (nodes[k], point[k]) {
+                (NO_NODE, _) => 0.0,
+                (_, Some(v)) => v,
+                (id, None) => self.importance(tree, id),
+            })
+        };
+        match quad {
+            Some(q) => self.scratch.quads.borrow_mut().get_or(q, |_| lanes(nodes)),
+            None => lanes(nodes),
+        }
+    }
+
+    /// The descent below the cut from cluster root `start`, binary or four-wide.
+    fn descend<R: DescentRandom>(
+        &self,
+        tree: &LightTree,
+        start: NodeId,
+        rng: &mut R,
+    ) -> Option<(usize, f32)> {
+        if self.four_wide {
+            let mut lanes = |q: Option<u32>, nodes: &[NodeId; 4]| self.quad_lanes(tree, q, nodes);
+            tree.sample_quads(start, &mut lanes, rng)
+        } else {
+            tree.sample_subtree(start, |c| self.importance(tree, c), rng)
+        }
     }
 
     /// Chooses a light: `(light, selection probability)`: a cluster by I_BO, then a descent by
@@ -117,9 +207,7 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
         } else {
             let cut = self.cut();
             let (k, p_cl, _) = cut.pick(u_cluster)?;
-            let imp = |c| self.importance(tree, c);
-            let (light, p) =
-                tree.sample_subtree(cut.cut.nodes[k], imp, &mut Rescaled(rng.next_u64()))?;
+            let (light, p) = self.descend(tree, cut.cut.nodes[k], &mut Rescaled(rng.next_u64()))?;
             Some((light, p_cl * p))
         }
     }
@@ -135,8 +223,12 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
     ) -> Option<(usize, f32)> {
         let cut = self.cut();
         let (k, p_cl, _) = cut.pick(u_cluster)?;
-        let imp = |c| self.importance(tree, c);
-        let (light, p) = tree.sample_subtree(cut.cut.nodes[k], imp, &mut Fresh(next))?;
+        let start = cut.cut.nodes[k];
+        let (light, p) = if self.four_wide {
+            self.descend(tree, start, &mut FreshPerStep::new(next))?
+        } else {
+            self.descend(tree, start, &mut Fresh(next))?
+        };
         Some((light, p_cl * p))
     }
 
@@ -150,7 +242,14 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
         if !(p_cl > 0.0) {
             return 0.0;
         }
-        p_cl * tree.pmf_subtree(cut.cut.nodes[k], |c| self.importance(tree, c), light)
+        let start = cut.cut.nodes[k];
+        let p = if self.four_wide {
+            let mut lanes = |q: Option<u32>, nodes: &[NodeId; 4]| self.quad_lanes(tree, q, nodes);
+            tree.pmf_quads(start, &mut lanes, light)
+        } else {
+            tree.pmf_subtree(start, |c| self.importance(tree, c), light)
+        };
+        p_cl * p
     }
 
     /// Samples a point on `light` (its own shape sampling, or the pivot-sphere mixture).
