@@ -360,6 +360,28 @@ pub(crate) fn slots_importance<L: Lanes, S: FourSlots>(
     x: Vec3,
     n: Vec3,
 ) -> [f32; 4] {
+    slots_evaluated::<L, S>(s, q, x, n).importance
+}
+
+/// What [`slots_importance`] computes on the way, lane by lane.
+pub(crate) struct SlotsEvaluated {
+    /// The compact importance.
+    pub(crate) importance: [f32; 4],
+    /// The decoded box centre − x, per axis.
+    pub(crate) to_centre: [[f32; 4]; 3],
+    /// The decoded box's half-diagonal squared (the bounding sphere's radius²).
+    pub(crate) radius_sq: [f32; 4],
+}
+
+/// [`slots_importance`] with its decoded centres and radii (unused outputs cost nothing once
+/// inlined).
+#[inline(always)]
+pub(crate) fn slots_evaluated<L: Lanes, S: FourSlots>(
+    s: &S,
+    q: &Quant,
+    x: Vec3,
+    n: Vec3,
+) -> SlotsEvaluated {
     let code = |c: [u16; 4]| L::quad(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32);
     let half_l = L::splat(0.5);
     let mut c = [L::splat(0.0); 3];
@@ -447,7 +469,11 @@ pub(crate) fn slots_importance<L: Lanes, S: FourSlots>(
     let power = L::quad(pw[0], pw[1], pw[2], pw[3]);
     let outside = power * emit * recv / d2c;
     let value = L::select(inside, power / d2c, cone_dark.andnot(outside));
-    dark.andnot(value).out()
+    SlotsEvaluated {
+        importance: dark.andnot(value).out(),
+        to_centre: c.map(L::out),
+        radius_sq: r2.out(),
+    }
 }
 
 impl LightTree {
@@ -470,6 +496,18 @@ impl LightTree {
     pub(crate) fn quad_node_importances(&self, quad: u32, x: Vec3, n: Vec3) -> [f32; 4] {
         let c = &self.compact;
         slots_importance::<Fast, _>(&c.quads[quad as usize], &c.quant, x, n)
+    }
+
+    /// What a caller's weight of quad `quad`'s four nodes can reuse at `x` (see
+    /// [`crate::QuadView`]).
+    pub fn quad_view(&self, quad: u32, x: Vec3) -> crate::QuadView {
+        let c = &self.compact;
+        let e = slots_evaluated::<Fast, _>(&c.quads[quad as usize], &c.quant, x, Vec3::ZERO);
+        crate::QuadView {
+            to_centre: e.to_centre,
+            radius_sq: e.radius_sq,
+            emit: e.importance,
+        }
     }
 
     /// Index of the pair that holds `node`'s children; `None` for a leaf.

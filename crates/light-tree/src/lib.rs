@@ -85,7 +85,7 @@ mod split_tests;
 mod tests;
 
 pub use cone::Cone;
-pub use quad_descent::{NO_NODE, QuadWeights};
+pub use quad_descent::{NO_NODE, QuadView, QuadWeights};
 pub use query::{Cut, DescentRandom, Fresh, Rescaled, SplitCriterion, SplitParams};
 pub use sg::{
     SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,

@@ -16,6 +16,21 @@ use crate::{LightTree, NodeId};
 /// A lane that holds no node (the second lane of a leaf's half, the pair step's lanes 2, 3).
 pub const NO_NODE: NodeId = NodeId::MAX;
 
+/// A quad's four nodes as its compact lanes bound them, seen from a point x: what a caller's
+/// weight ([`QuadWeights`]) can take instead of reading the four full nodes (four more cache
+/// lines). The bounds are the compact ones, rounded outward (`compact.rs`); an empty lane has
+/// zero `emit`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct QuadView {
+    /// The decoded box centre − x, per axis (x, y, z), per lane.
+    pub to_centre: [[f32; 4]; 3],
+    /// The decoded box's half-diagonal squared: the bounding sphere's radius².
+    pub radius_sq: [f32; 4],
+    /// The compact E&K importance without a receiver term: Φ·cos θ′/max(d², r²/4), 0 where
+    /// the emitters cannot reach x.
+    pub emit: [f32; 4],
+}
+
 /// A caller's weight for [`LightTree::sample_quads`] / [`LightTree::pmf_quads`].
 pub trait QuadWeights {
     /// Non-negative weights of the four `nodes` of one step; lanes holding [`NO_NODE`] must not
@@ -61,6 +76,11 @@ impl<W: QuadWeights> StepWeights for ByNode<'_, W> {
 }
 
 impl LightTree {
+    /// The number of quads (one per interior node at even depth).
+    pub fn num_quads(&self) -> u32 {
+        self.compact.quads.len() as u32
+    }
+
     /// The four nodes in the lanes of quad `quad` ([`NO_NODE`] for an empty lane), in lane
     /// order: the left child's two children, then the right child's.
     pub fn quad_nodes(&self, quad: u32) -> &[NodeId; 4] {

@@ -74,9 +74,9 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
     /// `terms(node).importance` up to f32 rounding), `None` where the caller must use
     /// [`BoRecord::terms`]. All `None` when the record has no point form.
     pub fn point_importances(&self, nodes: [&Node; 4]) -> [Option<f32>; 4] {
-        let Some(pk) = self.peak.filter(|_| self.point_approx && self.ks > 0.0) else {
+        if self.point_peak().is_none() {
             return [None; 4];
-        };
+        }
         let g = gather(nodes);
         let x = [self.x.x, self.x.y, self.x.z].map(Vec4::splat);
         let half = |k: usize| (g.hi[k] - g.lo[k]) * 0.5;
@@ -90,7 +90,6 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
         let d2 = dot3(&to_c, &to_c);
         let r2 = g.radius * g.radius;
         let d2c = d2.max(0.25 * r2).max(Vec4::splat(MIN_DIST_SQ));
-        let outside = d2.cmpgt(r2);
         let inv_d = d2.sqrt().recip();
         let w = to_c.map(|c| c * inv_d);
         let sin_u = (g.radius * inv_d).min(Vec4::ONE);
@@ -107,6 +106,36 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
             g.power * cos_p.max(Vec4::splat(MIN_EMIT_COS)) / d2c,
             Vec4::ZERO,
         );
+        self.point_lanes(to_c, r2, emit)
+    }
+
+    /// I_BO of a quad's four nodes from its compact view ([`light_tree::QuadView`]: decoded
+    /// centres and radii and the compact emitter bound), without reading the nodes: `Some`
+    /// where the point form applies to those bounds, `None` where the caller must use
+    /// [`BoRecord::terms`] (on the exact node). The compact bounds contain the exact ones, so
+    /// a lane is close to, not equal to, `terms`.
+    pub fn point_importances_view(&self, view: &light_tree::QuadView) -> [Option<f32>; 4] {
+        if self.point_peak().is_none() {
+            return [None; 4];
+        }
+        let to_c = view.to_centre.map(Vec4::from_array);
+        let r2 = Vec4::from_array(view.radius_sq);
+        self.point_lanes(to_c, r2, Vec4::from_array(view.emit))
+    }
+
+    fn point_peak(&self) -> Option<super::importance::PeakBound> {
+        self.peak.filter(|_| self.point_approx && self.ks > 0.0)
+    }
+
+    /// The point form of `terms` in four lanes, from each node's centre − x, radius² and
+    /// emitter bound.
+    #[inline(always)]
+    fn point_lanes(&self, to_c: [Vec4; 3], r2: Vec4, emit: Vec4) -> [Option<f32>; 4] {
+        let Some(pk) = self.point_peak() else {
+            return [None; 4];
+        };
+        let d2 = dot3(&to_c, &to_c);
+        let outside = d2.cmpgt(r2);
 
         // The cap in the shading frame, as `terms` computes it.
         let d = d2.sqrt();
@@ -236,5 +265,40 @@ mod tests {
             taken * 2 > lanes,
             "only {taken} of {lanes} lanes took the point form"
         );
+
+        // From the quads' compact view: positive wherever `terms` is, and close to it (the
+        // compact boxes are the exact ones rounded outward to 16 bits).
+        let mut rel = Vec::new();
+        for case in 0..20 {
+            let n = Vec3::Z;
+            let wo = Vec3::new(rng.random_range(-1.0..1.0), 0.2, 0.8).normalize();
+            let frame = Frame::from_normal_and_direction(n, wo);
+            let lobe = sptd.lobe(frame.to_local(wo), [0.05, 0.2][case % 2]);
+            let x = Vec3::new(
+                rng.random_range(-20.0..20.0),
+                rng.random_range(-20.0..20.0),
+                0.0,
+            );
+            let rec = BoRecord::from_parts(x, frame, lobe, 0.6, 0.3, true, false);
+            for q in 0..tree.num_quads() {
+                let ids = *tree.quad_nodes(q);
+                let lanes = rec.point_importances_view(&tree.quad_view(q, x));
+                for k in 0..4 {
+                    let (id, Some(v)) = (ids[k], lanes[k]) else {
+                        continue;
+                    };
+                    assert_ne!(id, light_tree::NO_NODE, "an empty lane takes no point form");
+                    let s = rec.terms(tree.node(id)).importance;
+                    if s > 0.0 {
+                        assert!(v > 0.0, "quad {q} lane {k}: view {v}, scalar {s}");
+                        rel.push(((v - s) / s).abs());
+                    }
+                }
+            }
+        }
+        rel.sort_by(f32::total_cmp);
+        assert!(rel.len() > 1000, "{} lanes compared", rel.len());
+        let median = rel[rel.len() / 2];
+        assert!(median < 1e-2, "median relative difference {median}");
     }
 }

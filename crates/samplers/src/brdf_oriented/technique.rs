@@ -145,13 +145,16 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
     /// cluster root per node).
     fn quad_lanes(&self, tree: &LightTree, quad: Option<u32>, nodes: &[NodeId; 4]) -> [f32; 4] {
         let lanes = |nodes: &[NodeId; 4]| {
-            let point = match self.sg {
-                None => {
+            let point = match (&self.sg, quad) {
+                (None, Some(q)) => self
+                    .rec
+                    .point_importances_view(&tree.quad_view(q, self.rec.x)),
+                (None, None) => {
                     // An empty lane (always after a real one) borrows the first node.
                     let node = |id: NodeId| tree.node(if id == NO_NODE { nodes[0] } else { id });
                     self.rec.point_importances(nodes.map(node))
                 }
-                Some(_) => [None; 4],
+                (Some(_), _) => [None; 4],
             };
             std::array::from_fn(|k| match (nodes[k], point[k]) {
                 (NO_NODE, _) => 0.0,
