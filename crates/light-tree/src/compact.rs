@@ -29,10 +29,7 @@ const QMAX: u32 = u16::MAX as u32;
 /// Scale of the signed cosine and axis codes.
 const QSIGNED: f32 = i16::MAX as f32;
 
-/// Floor of the squared distance, as in the exact importance.
-const MIN_DIST_SQ: f32 = 1e-12;
-/// Emitter cosine floor for θe > π/2, as in the exact importance.
-const MIN_EMIT_COS: f32 = 1e-3;
+use crate::query::{MIN_DIST_SQ, MIN_EMIT_COS};
 /// Slack added to θo beyond the axis' quantisation angle (f32 rounding of the decoded axis).
 const AXIS_SLACK: f64 = 1e-5;
 

@@ -86,7 +86,9 @@ mod tests;
 
 pub use cone::Cone;
 pub use quad_descent::{NO_NODE, QuadView, QuadWeights};
-pub use query::{Cut, DescentRandom, Fresh, Rescaled, SplitCriterion, SplitParams};
+pub use query::{
+    Cut, DescentRandom, Fresh, MIN_DIST_SQ, MIN_EMIT_COS, Rescaled, SplitCriterion, SplitParams,
+};
 pub use sg::{
     SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,
 };

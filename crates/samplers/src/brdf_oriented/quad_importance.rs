@@ -12,12 +12,9 @@
 use super::importance::{BoRecord, LobeDensity};
 use brdf_integrals::LobeIntegral;
 use glam::{BVec4A, Vec4};
-use light_tree::Node;
+use light_tree::{MIN_DIST_SQ, MIN_EMIT_COS, Node};
 use std::f32::consts::PI;
 
-/// Floors of the tree's E&K importance (`light_tree::Node::importance`), repeated here.
-const MIN_DIST_SQ: f32 = 1e-12;
-const MIN_EMIT_COS: f32 = 1e-3;
 /// Largest sin² of a cap's half-angle that takes the point form (`point_estimate`).
 const POINT_SIN2: f32 = 0.0606;
 
@@ -74,6 +71,7 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
     /// `terms(node).importance` up to f32 rounding), `None` where the caller must use
     /// [`BoRecord::terms`]. All `None` when the record has no point form.
     pub fn point_importances(&self, nodes: [&Node; 4]) -> [Option<f32>; 4] {
+        // Checked before the gather, which is the costly part here.
         if self.point_peak().is_none() {
             return [None; 4];
         }
@@ -115,9 +113,6 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
     /// [`BoRecord::terms`] (on the exact node). The compact bounds contain the exact ones, so
     /// a lane is close to, not equal to, `terms`.
     pub fn point_importances_view(&self, view: &light_tree::QuadView) -> [Option<f32>; 4] {
-        if self.point_peak().is_none() {
-            return [None; 4];
-        }
         let to_c = view.to_centre.map(Vec4::from_array);
         let r2 = Vec4::from_array(view.radius_sq);
         self.point_lanes(to_c, r2, Vec4::from_array(view.emit))
