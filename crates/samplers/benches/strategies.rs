@@ -67,9 +67,13 @@ fn bench_strategies(c: &mut Criterion) {
             .measurement_time(Duration::from_secs(1))
             .throughput(Throughput::Elements(points.len() as u64));
         // Every strategy with the defaults, then the method's variants (issue 24: BO weighed by
-        // the SG importance) under a name of their own.
+        // the SG importance; BO's binary descent) under a name of their own.
         let sg = StrategyOptions {
             bo_importance: samplers::brdf_oriented::BoImportance::Sg,
+            ..options.clone()
+        };
+        let binary = StrategyOptions {
+            binary_bo_descent: true,
             ..options.clone()
         };
         let variants = samplers::strategies()
@@ -78,6 +82,11 @@ fn bench_strategies(c: &mut Criterion) {
             .chain(
                 ["brdf-oriented", "mis3-equal", "mis3-adaptive"]
                     .map(|n| (format!("{n} --bo-importance sg"), n, &sg)),
+            )
+            // BO's paper descent beside our four-wide default, in the same sitting.
+            .chain(
+                ["brdf-oriented", "mis3-adaptive", "ris"]
+                    .map(|n| (format!("{n} --binary-bo-descent"), n, &binary)),
             );
         for (id, name, opts) in variants {
             let strategy = samplers::create(name, &scene, opts).unwrap();
