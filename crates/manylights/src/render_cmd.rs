@@ -196,6 +196,10 @@ pub struct MethodArgs {
     /// paper, instead of the tree's four-wide descent (--reproduce implies it).
     #[arg(long)]
     pub binary_bo_descent: bool,
+    /// mis3-adaptive: no pilot; N_max stays --n-max until two passes are done, then is learnt
+    /// (the pilot, one pixel in 16 with two samples before the first pass, learns it at once).
+    #[arg(long)]
+    pub no_pilot: bool,
     /// Learned selection: what a region learns of each cluster, `contribution` (its observed
     /// contribution over its prior) or `visibility` (its shadow rays' hit rate).
     #[arg(long, default_value = LearnedConfig::default().target.name(),
@@ -311,6 +315,7 @@ impl MethodArgs {
             stratified: !self.independent_samples,
             split_ls_at_glossy: self.split_ls_at_glossy,
             binary_bo_descent: self.binary_bo_descent,
+            pilot: !self.no_pilot,
             learned: LearnedConfig {
                 target: self.learned_target,
                 clusters: self.learned_clusters,
@@ -532,6 +537,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "unsampled_pixels": result.unsampled_pixels(),
         "work_unit_pixels": render_core::render::UNIT_PIXELS,
         "passes": result.passes,
+        "pilot_camera_samples": result.pilot_samples,
         "spp_requested": spp,
         "time_budget_s": args.time_budget,
         "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),

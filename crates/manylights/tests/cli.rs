@@ -381,6 +381,7 @@ fn mis3_flags_and_false_colour_aux() {
             vec!["--reproduce", "--pivot-sphere", "--max-cut", "16"],
         ),
         ("noh", vec!["--no-adaptive-total", "--no-adaptive-split"]),
+        ("nopilot", vec!["--n-max", "20", "--no-pilot"]),
     ] {
         let out = dir.join(format!("{name}.exr"));
         let mut args = vec![
@@ -417,11 +418,45 @@ fn mis3_flags_and_false_colour_aux() {
     let meta: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("adaptive.json")).unwrap()).unwrap();
     assert_eq!(meta["strategy_parameters"]["n_max"], 20);
-    // Our defaults: N_max per pass (logged from pass 1 at --n-max), one LS descent at glossy
-    // points and stratified BRDF-aware samples; --reproduce keeps the paper's constant N_max,
-    // E&K cut and independent samples.
+    // Our defaults: N_max per pass (from pass 1 at --n-max: the image is too small for a
+    // pilot), one LS descent at glossy points and stratified BRDF-aware samples; --reproduce
+    // keeps the paper's constant N_max, E&K cut and independent samples.
     let params = &meta["strategy_parameters"];
     assert_eq!(params["n_max_by_pass"][0], serde_json::json!([1, 20.0]));
+    assert_eq!(params["pilot"], true);
+    assert_eq!(meta["pilot_camera_samples"], 0);
+    // From 64 × 64 on, a pilot of one pixel in 16 (two samples each) sets N_max for pass 1.
+    let out = dir.join("pilot.exr");
+    let o = manylights(&[
+        "render",
+        SCENE,
+        "--strategy",
+        "mis3-adaptive",
+        "--spp",
+        "1",
+        "--width",
+        "64",
+        "--height",
+        "64",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let pilot: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("pilot.json")).unwrap()).unwrap();
+    assert_eq!(pilot["pilot_camera_samples"], 2 * 16 * 16);
+    let by_pass = pilot["strategy_parameters"]["n_max_by_pass"]
+        .as_array()
+        .unwrap();
+    assert_eq!(by_pass.len(), 1, "{by_pass:?}");
+    assert_eq!(by_pass[0][0], 1);
+    let nopilot: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("nopilot.json")).unwrap()).unwrap();
+    let np = &nopilot["strategy_parameters"];
+    assert_eq!(np["n_max_by_pass"][0], serde_json::json!([1, 20.0]));
+    assert_eq!(np["pilot"], false);
+    assert_eq!(nopilot["pilot_camera_samples"], 0);
     assert_eq!(params["efficient_total"], true);
     assert_eq!(params["single_ls_at_glossy"], true);
     assert_eq!(params["stratified"], true);
@@ -430,6 +465,8 @@ fn mis3_flags_and_false_colour_aux() {
     let params = &repro["strategy_parameters"];
     assert!(params.get("n_max_by_pass").is_none());
     assert_eq!(params["efficient_total"], false);
+    assert_eq!(params["pilot"], false);
+    assert_eq!(repro["pilot_camera_samples"], 0);
     assert_eq!(params["single_ls_at_glossy"], false);
     assert_eq!(params["stratified"], false);
     // τ: as given; else ours (0.35), or the authors' 0.85 under --reproduce, so that changing

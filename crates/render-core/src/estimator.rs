@@ -1,6 +1,7 @@
 //! The interface between the render loop and light-sampling strategies.
 use crate::bsdf::Bsdf;
 use crate::light::LightSample;
+use crate::pilot::Pilot;
 use crate::rng::SampleStream;
 use crate::scene::{Scene, SurfaceHit, offset_origin};
 use crate::stats::Counters;
@@ -87,4 +88,12 @@ pub trait DirectLighting: Send + Sync {
     /// Called after each complete pass with every pixel's memory, in pixel order (so what the
     /// strategy learns is the same for any thread count); the next pass sees what it keeps.
     fn end_pass(&self, _pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {}
+    /// The pilot the strategy wants before its first pass (`crate::pilot`) on a sample grid of
+    /// `width` × `height` pixels, if any; asked after `begin_render`.
+    fn pilot(&self, _width: usize, _height: usize) -> Option<Pilot> {
+        None
+    }
+    /// Called once after the pilot with its pixels' memory, in pixel order; what the strategy
+    /// keeps from it applies from the first pass on. The pilot's samples are not in the image.
+    fn end_pilot(&self, _pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {}
 }

@@ -22,6 +22,7 @@ pub mod light;
 pub mod material;
 pub mod metrics;
 pub mod output;
+pub mod pilot;
 pub mod render;
 pub mod sampling;
 pub mod scene;

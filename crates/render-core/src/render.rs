@@ -13,6 +13,7 @@ use crate::camera::Camera;
 use crate::emission_rays::{EmissionRays, plan_splits};
 use crate::estimator::{DirectLighting, MAX_AUX, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use crate::filter::PixelFilter;
+use crate::pilot::Pilot;
 use crate::rng::SampleStream;
 use crate::sampler::Sampler;
 use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
@@ -20,6 +21,7 @@ use crate::splat::{PassSample, Reconstruction, SampleGrid, SplatFilm};
 use crate::stats::Counters;
 use glam::{Vec2, Vec3};
 use host::process_cpu_seconds;
+use rayon::prelude::*;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
@@ -137,6 +139,9 @@ pub struct RenderResult {
     pub passes: u32,
     /// Worker threads the passes ran on.
     pub threads: usize,
+    /// Camera samples of the strategy's pilot (`crate::pilot`; not in the image, their work in
+    /// `counters` and the seconds).
+    pub pilot_samples: u64,
     /// Pixels without any sample (a budget spent inside the first pass).
     unsampled: usize,
 }
@@ -240,6 +245,89 @@ impl PassJob<'_> {
         (sum, lit)
     }
 
+    /// `rng` told where pixel `index` lies in the sample grid (for samplers ordered across pixels).
+    fn in_grid(&self, index: usize, rng: SampleStream) -> SampleStream {
+        let grid = self.grid;
+        rng.in_image(
+            ((index % grid.width) as u32, (index / grid.width) as u32),
+            (grid.width as u32, grid.height as u32),
+        )
+    }
+
+    /// A camera sample's position in pixel `index`: on the film in pixels, on the film in
+    /// [0, 1]², and the filter weight it carries.
+    fn film_position(&self, index: usize, rng: &mut SampleStream) -> (Vec2, Vec2, f32) {
+        let s = self.settings;
+        let (x, y) = self.grid.image_xy(index);
+        let (offset, weight) = match s.reconstruction {
+            Reconstruction::Sampled => s.filter.sample(rng.next_2d()),
+            // pbrt-v3: uniform over the pixel; the filter weighs the sample at the gather.
+            Reconstruction::Splat => (rng.next_2d(), 1.0),
+        };
+        let on_film = Vec2::new(x as f32 + offset.x, y as f32 + offset.y);
+        let film = on_film / Vec2::new(s.width as f32, s.height as f32);
+        (on_film, film, weight)
+    }
+
+    /// Runs `pilot` (`crate::pilot`) on the worker threads and hands the strategy its pixels'
+    /// memory in pixel order; returns what it counted and its camera samples.
+    fn run_pilot(&self, pool: &rayon::ThreadPool, pilot: Pilot) -> (Counters, u64) {
+        let pixels = pilot.pixels(self.grid.width, self.grid.height);
+        let mut memory = vec![[0.0f32; PIXEL_MEMORY]; pixels.len()];
+        let per_chunk: Vec<Counters> = pool.install(|| {
+            memory
+                .par_chunks_mut(UNIT_PIXELS)
+                .zip(pixels.par_chunks(UNIT_PIXELS))
+                .map(|(memory, pixels)| {
+                    let mut c = Counters::default();
+                    for (m, &index) in memory.iter_mut().zip(pixels) {
+                        for sample in 0..pilot.samples {
+                            self.pilot_sample(pilot, index, sample, m, &mut c);
+                        }
+                    }
+                    c
+                })
+                .collect()
+        });
+        let mut counters = Counters::default();
+        for c in &per_chunk {
+            counters.merge(c);
+        }
+        self.strategy.end_pilot(&mut memory.iter());
+        (counters, pixels.len() as u64 * pilot.samples as u64)
+    }
+
+    /// One pilot sample of pixel `index`: only the strategy's pixel memory keeps anything.
+    fn pilot_sample(
+        &self,
+        pilot: Pilot,
+        index: usize,
+        sample: u32,
+        memory: &mut [f32; PIXEL_MEMORY],
+        c: &mut Counters,
+    ) {
+        let s = self.settings;
+        let mut rng = self.in_grid(
+            index,
+            pilot.stream(s.sampler, s.seed, index as u64, sample as u64),
+        );
+        let (_, film, _) = self.film_position(index, &mut rng);
+        let mut ctx = SampleContext {
+            counters: c,
+            aux: [0.0; MAX_AUX],
+            pixel_memory: memory,
+        };
+        shade_camera_sample(
+            self.scene,
+            self.strategy,
+            &s.camera,
+            self.aspect,
+            film,
+            &mut rng,
+            &mut ctx,
+        );
+    }
+
     /// Sample `sample_index` of the pixels of work unit `u`, accumulated into `unit` and, when
     /// splatting, kept in `splats` for the pass's gather.
     fn render_unit(
@@ -249,29 +337,19 @@ impl PassJob<'_> {
         (unit, splats): (&mut [PixelAccum], &mut [PassSample]),
         c: &mut Counters,
     ) {
-        let (w, h) = (self.settings.width as f32, self.settings.height as f32);
-        let grid = self.grid;
         for (i, px) in unit.iter_mut().enumerate() {
             let index = u * UNIT_PIXELS + i;
-            let (x, y) = grid.image_xy(index);
-            let mut rng = SampleStream::with_sampler(
-                self.settings.sampler,
-                self.settings.seed,
-                index as u64,
-                sample_index,
-            )
-            .with_pixel_samples(self.settings.spp.unwrap_or(0))
-            .in_image(
-                ((index % grid.width) as u32, (index / grid.width) as u32),
-                (grid.width as u32, grid.height as u32),
+            let mut rng = self.in_grid(
+                index,
+                SampleStream::with_sampler(
+                    self.settings.sampler,
+                    self.settings.seed,
+                    index as u64,
+                    sample_index,
+                )
+                .with_pixel_samples(self.settings.spp.unwrap_or(0)),
             );
-            let (offset, weight) = match self.settings.reconstruction {
-                Reconstruction::Sampled => self.settings.filter.sample(rng.next_2d()),
-                // pbrt-v3: uniform over the pixel; the filter weighs the sample at the gather.
-                Reconstruction::Splat => (rng.next_2d(), 1.0),
-            };
-            let on_film = Vec2::new(x as f32 + offset.x, y as f32 + offset.y);
-            let film = on_film / Vec2::new(w, h);
+            let (on_film, film, weight) = self.film_position(index, &mut rng);
             // Fixed before the sample is drawn, from the pixel's earlier passes only.
             let rays = self.settings.emission_rays.rays_for(px.split);
             let mut ctx = SampleContext {
@@ -497,6 +575,12 @@ pub fn render(
         grid,
     };
     let mut counters = Counters::default();
+    let mut pilot_samples = 0;
+    if let Some(pilot) = strategy.pilot(grid.width, grid.height) {
+        let (c, n) = job.run_pilot(&pool, pilot);
+        counters.merge(&c);
+        pilot_samples = n;
+    }
     let mut spp_done = 0u32;
     let mut passes = 0u32;
     let mut partial_pixels = 0usize;
@@ -618,6 +702,7 @@ pub fn render(
         cpu_seconds,
         passes,
         threads,
+        pilot_samples,
         unsampled: image.unsampled,
     })
 }
@@ -791,6 +876,103 @@ mod tests {
             reconstruction: Default::default(),
             emission_rays: Default::default(),
         }
+    }
+
+    /// `OneLight` that asks for a pilot (when `pilot`) and keeps what the pilot's pixels
+    /// remembered: per pixel the samples shaded and the sum of their first random numbers.
+    struct PilotRecorder {
+        pilot: bool,
+        seen: Mutex<Vec<[f32; 2]>>,
+        /// Every pixel's memory after the image's second pass.
+        second_pass: Mutex<Vec<[f32; 2]>>,
+    }
+
+    impl DirectLighting for PilotRecorder {
+        fn name(&self) -> String {
+            "test-pilot-recorder".into()
+        }
+
+        fn estimate(
+            &self,
+            scene: &Scene,
+            sp: &ShadingPoint,
+            rng: &mut SampleStream,
+            ctx: &mut SampleContext,
+        ) -> Vec3 {
+            ctx.pixel_memory[0] += 1.0;
+            let mut probe = rng.clone();
+            ctx.pixel_memory[1] += probe.next_f32();
+            OneLight.estimate(scene, sp, rng, ctx)
+        }
+
+        fn pilot(&self, _: usize, _: usize) -> Option<Pilot> {
+            self.pilot.then_some(Pilot {
+                stride: 4,
+                samples: 2,
+            })
+        }
+
+        fn end_pilot(&self, memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+            *self.seen.lock().unwrap() = memory.map(|m| [m[0], m[1]]).collect();
+        }
+
+        fn end_pass(&self, memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+            let all: Vec<[f32; 2]> = memory.map(|m| [m[0], m[1]]).collect();
+            if all.iter().any(|m| m[0] == 2.0) && all.iter().all(|m| m[0] <= 2.0) {
+                *self.second_pass.lock().unwrap() = all;
+            }
+        }
+    }
+
+    /// The image, what the pilot's pixels remembered, every pixel's memory after pass 2.
+    type PilotRun = (RenderResult, Vec<[f32; 2]>, Vec<[f32; 2]>);
+
+    fn run_pilot(scene: &Scene, pilot: bool, threads: usize) -> PilotRun {
+        let strategy = PilotRecorder {
+            pilot,
+            seen: Mutex::new(Vec::new()),
+            second_pass: Mutex::new(Vec::new()),
+        };
+        let s = settings(scene, Some(3), None, threads, Sampler::Independent);
+        let image = render(scene, &strategy, &s, &|_, _| {}).unwrap();
+        let seen = strategy.seen.into_inner().unwrap();
+        (image, seen, strategy.second_pass.into_inner().unwrap())
+    }
+
+    #[test]
+    fn a_pilot_is_kept_out_of_the_image_and_the_same_for_any_thread_count() {
+        let scene = test_scene();
+        let (plain, none, image_memory) = run_pilot(&scene, false, 2);
+        assert!(none.is_empty());
+        assert_eq!(plain.pilot_samples, 0);
+        let (one, seen_one, _) = run_pilot(&scene, true, 1);
+        let (three, seen_three, _) = run_pilot(&scene, true, 3);
+        // The image's samples are the same with and without the pilot.
+        assert_eq!(one.pixels, plain.pixels);
+        assert_eq!(three.pixels, plain.pixels);
+        // The pilot: the centres of the 4 × 4 blocks, two samples each with the memory carried
+        // from the first to the second, the same numbers for any thread count.
+        let pixels = Pilot {
+            stride: 4,
+            samples: 2,
+        }
+        .pixels(64, 40);
+        assert_eq!(seen_one.len(), pixels.len());
+        assert_eq!(one.pilot_samples, 2 * pixels.len() as u64);
+        assert_eq!(seen_one, seen_three);
+        assert!(seen_one.iter().all(|m| m[0] == 0.0 || m[0] == 2.0));
+        assert!(seen_one.iter().filter(|m| m[0] == 2.0).count() > pixels.len() / 2);
+        // Its numbers are not the image's: the image's first two samples of the same pixels
+        // drew other numbers.
+        let mut compared = 0;
+        for (m, &p) in seen_one.iter().zip(&pixels) {
+            if m[0] == 2.0 && image_memory[p][0] == 2.0 {
+                assert_ne!(m[1], image_memory[p][1], "pixel {p}");
+                compared += 1;
+            }
+        }
+        assert!(compared > pixels.len() / 2);
+        assert!(one.counters.camera_rays > plain.counters.camera_rays);
     }
 
     /// No direct lighting: an image of the emission seen directly alone.

@@ -92,6 +92,9 @@ pub struct StrategyOptions {
     /// BO descends below its cut one binary level at a time, as the paper, instead of the
     /// tree's four-wide descent (`reproduce` and `--bo-importance sg` imply it).
     pub binary_bo_descent: bool,
+    /// With `efficient_total`, N_max is learnt from a pilot before the first pass (a few
+    /// samples on one pixel in 16, not in the image); off: `n_max` until two passes are done.
+    pub pilot: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
@@ -160,6 +163,7 @@ impl Default for StrategyOptions {
             stratified: true,
             split_ls_at_glossy: false,
             binary_bo_descent: false,
+            pilot: true,
             adaptive_split: true,
             learned: learned::LearnedConfig::default(),
         }

@@ -32,6 +32,7 @@ pub fn bo_config(opts: &StrategyOptions) -> BoConfig {
         four_wide_bo_descent: !opts.binary_bo_descent
             && !opts.reproduce
             && opts.bo_importance == BoImportance::Cap,
+        pilot: opts.pilot && opts.efficient_total && !opts.reproduce,
     }
 }
 

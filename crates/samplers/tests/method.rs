@@ -137,6 +137,31 @@ fn mis3_converges_on_diffuse_quads() {
     check_against_reference(&scene, Some((32, 24)), 128, 32);
 }
 
+/// From 64 × 64 on, mis3-adaptive learns N_max from a pilot before its first pass (none with
+/// `--no-pilot`): the image still converges to power+bsdf's and is the same for any thread
+/// count.
+#[test]
+fn mis3_with_its_pilot_converges_and_is_the_same_for_any_thread_count() {
+    let scene = common::mixed_scene(40);
+    let size = Some((64, 64));
+    let d = StrategyOptions::default();
+    let reference = render_opts(&scene, "power+bsdf", &d, 128, 1, size);
+    let r = render_opts(&scene, "mis3-adaptive", &d, 16, 2, size);
+    assert_eq!(r.pilot_samples, 2 * 16 * 16);
+    let failures = compare(&reference, &r, 2, 3.0);
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    let one = common::render_opts(&scene, "mis3-adaptive", &d, 2, 1, 5, size);
+    let two = common::render_opts(&scene, "mis3-adaptive", &d, 2, 2, 5, size);
+    assert_eq!(one.pixels, two.pixels);
+    assert_eq!(one.variance_of_mean, two.variance_of_mean);
+    let no_pilot = StrategyOptions {
+        pilot: false,
+        ..d.clone()
+    };
+    let without = common::render_opts(&scene, "mis3-adaptive", &no_pilot, 2, 1, 5, size);
+    assert_eq!(without.pilot_samples, 0);
+}
+
 #[test]
 fn reproduce_mode_and_bo_alone_run() {
     let scene = common::mixed_scene(20);

@@ -21,10 +21,14 @@ use light_tree::LightTree;
 use render_core::Vec3;
 use render_core::colour::luminance;
 use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
+use render_core::pilot::Pilot;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, Ordering};
+
+/// The fewest pixels a pilot of N_max may have (a 64 × 64 image at one pixel in 16).
+const MIN_PILOT_PIXELS: usize = 256;
 
 /// Which of the method's strategies a [`Mis3`] is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -150,6 +154,16 @@ impl<C: CapIntegral> Mis3<C> {
         }
         let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
         log.passes += 1;
+        self.adopt_n_max(&mut log, pixel_memory);
+    }
+
+    /// Sets N_max from the tallies of `pixel_memory` (unchanged without a pixel of two samples)
+    /// for pass `log.passes + 1` on, and logs it.
+    fn adopt_n_max(
+        &self,
+        log: &mut NMaxLog,
+        pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>,
+    ) {
         if let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory) {
             self.n_max_now.store(n_max.to_bits(), Ordering::Relaxed);
             if log.changes.last().map(|c| c.1) != Some(n_max) {
@@ -237,6 +251,32 @@ where
         log.passes = 0;
         log.changes.clear();
         log.changes.push((1, self.config.n_max as f32));
+    }
+
+    /// Heuristic 1's N_max learnt from a pilot, so that the first passes of a short render
+    /// already use it: one pixel in 4 × 4, two samples each (an eighth of a pass). Not on
+    /// images below 64 × 64, where so few pixels would make a noisier choice than the one
+    /// after pass 2.
+    fn pilot(&self, width: usize, height: usize) -> Option<Pilot> {
+        let pilot = Pilot {
+            stride: 4,
+            samples: 2,
+        };
+        let enough = pilot.pixels(width, height).len() >= MIN_PILOT_PIXELS;
+        (self.learns_n_max() && self.config.pilot && enough).then_some(pilot)
+    }
+
+    fn end_pilot(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+        if !self.learns_n_max() {
+            return;
+        }
+        let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
+        // From pass 1 on: the log's first entry is replaced, not followed.
+        log.changes.clear();
+        log.changes.push((1, self.n_max_now()));
+        self.adopt_n_max(&mut log, pixel_memory);
+        let first = log.changes.len() - 1;
+        log.changes.drain(..first);
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {

@@ -149,6 +149,10 @@ pub struct BoConfig {
     /// nodes at once); off (the authors' code, and under the SG importance): the binary one.
     #[serde(default)]
     pub four_wide_bo_descent: bool,
+    /// With `efficient_total`: N_max learnt from a pilot before the first pass
+    /// (`render_core::pilot`) instead of keeping `n_max` until two passes are done.
+    #[serde(default)]
+    pub pilot: bool,
 }
 
 /// The SPTD pivot of a lobe, where the approximation has one.
