@@ -223,6 +223,54 @@ fn compact_descent_matches_the_generic_one() {
     }
 }
 
+/// `pmf_from_cached` is `pmf_from` bit for bit, whether its cache starts empty, holds every
+/// quad it reads, or forgets some between replays (a direct-mapped cache evicts).
+#[test]
+fn cached_pmf_replay_matches_the_uncached_one() {
+    struct Lossy {
+        map: std::collections::HashMap<u32, [f32; 4]>,
+        hits: usize,
+        drop_odd: bool,
+    }
+    impl crate::QuadLaneCache for Lossy {
+        fn get(&mut self, quad: u32) -> Option<[f32; 4]> {
+            let v = self.map.get(&quad).copied();
+            self.hits += v.is_some() as usize;
+            v
+        }
+        fn insert(&mut self, quad: u32, lanes: [f32; 4]) {
+            if !(self.drop_odd && quad % 2 == 1) {
+                self.map.insert(quad, lanes);
+            }
+        }
+    }
+    let mut rng = Pcg32::seed_from_u64(46);
+    for (tree, _) in trees(&mut rng) {
+        for drop_odd in [false, true] {
+            for _ in 0..20 {
+                let (x, n) = rand_receiver(&mut rng);
+                let start = rng.random_range(0..tree.nodes().len() as NodeId);
+                let mut cache = Lossy {
+                    map: Default::default(),
+                    hits: 0,
+                    drop_odd,
+                };
+                for _ in 0..2 {
+                    for light in 0..tree.num_lights().min(64) {
+                        assert_eq!(
+                            tree.pmf_from_cached(start, x, n, light, &mut cache)
+                                .to_bits(),
+                            tree.pmf_from(start, x, n, light).to_bits()
+                        );
+                    }
+                }
+                // The second round read every quad the first one kept.
+                assert!(tree.num_quads() < 2 || cache.map.is_empty() || cache.hits > 0);
+            }
+        }
+    }
+}
+
 /// `importances` gives each node's `importance`, bit for bit, for node lists in any order:
 /// cuts (siblings side by side), random lists with repeats, the empty list.
 #[test]

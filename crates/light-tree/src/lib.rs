@@ -87,7 +87,8 @@ mod tests;
 pub use cone::Cone;
 pub use quad_descent::{NO_NODE, QuadView, QuadWeights};
 pub use query::{
-    Cut, DescentRandom, Fresh, MIN_DIST_SQ, MIN_EMIT_COS, Rescaled, SplitCriterion, SplitParams,
+    Cut, DescentRandom, Fresh, MIN_DIST_SQ, MIN_EMIT_COS, QuadLaneCache, Rescaled, SplitCriterion,
+    SplitParams,
 };
 pub use sg::{
     SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,

@@ -125,6 +125,39 @@ pub(crate) fn choose<R: DescentRandom>(il: f32, ir: f32, rng: &mut R) -> Option<
     Some(if left { (true, pl) } else { (false, ir / sum) })
 }
 
+/// A cache of one receiver's E&K quad lanes for [`LightTree::pmf_from_cached`], keyed by quad
+/// index. The lanes are a pure function of (quad, x, n), so a cached value is the recomputed one.
+pub trait QuadLaneCache {
+    /// The lanes of `quad`, if cached.
+    fn get(&mut self, quad: u32) -> Option<[f32; 4]>;
+    /// Keeps `lanes` as the lanes of `quad`.
+    fn insert(&mut self, quad: u32, lanes: [f32; 4]);
+}
+
+/// [`EkLanes`] through a [`QuadLaneCache`] (the odd-depth pair step, at most once per replay,
+/// is not cached).
+struct CachedEkLanes<'c, C> {
+    x: Vec3,
+    n: Vec3,
+    cache: &'c mut C,
+}
+
+impl<C: QuadLaneCache> StepWeights for CachedEkLanes<'_, C> {
+    #[inline(always)]
+    fn pair(&mut self, tree: &LightTree, _: NodeId, pair: u32) -> [f32; 2] {
+        tree.pair_importances(pair, self.x, self.n)
+    }
+    #[inline(always)]
+    fn quad(&mut self, tree: &LightTree, quad: u32) -> [f32; 4] {
+        if let Some(lanes) = self.cache.get(quad) {
+            return lanes;
+        }
+        let lanes = tree.quad_node_importances(quad, self.x, self.n);
+        self.cache.insert(quad, lanes);
+        lanes
+    }
+}
+
 /// The four-wide descent's lanes under the tree's compact E&K importance at (x, n).
 struct EkLanes {
     x: Vec3,
@@ -517,6 +550,21 @@ impl LightTree {
     /// is not under `start`), replayed along its bit trail with the same operations.
     pub fn pmf_from(&self, start: NodeId, x: Vec3, n: Vec3, light: usize) -> f32 {
         self.replay(start, &mut EkLanes { x, n }, light)
+    }
+
+    /// [`LightTree::pmf_from`] with each quad's lanes taken from `cache` when it has them and
+    /// put there when not: bit for bit the same value. For a caller that replays many pmfs at
+    /// one (x, n) (the method's MIS weights at a glossy point), whose replays share the top of
+    /// the tree; `cache` must hold lanes of this (x, n) only.
+    pub fn pmf_from_cached<C: QuadLaneCache>(
+        &self,
+        start: NodeId,
+        x: Vec3,
+        n: Vec3,
+        light: usize,
+        cache: &mut C,
+    ) -> f32 {
+        self.replay(start, &mut CachedEkLanes { x, n, cache }, light)
     }
 
     /// Generic descent from `start`: at each interior node go left with probability

@@ -5,7 +5,7 @@
 //! bit-identical to a recomputed one: sampling and every pdf replay see the same numbers
 //! whether or not a slot was evicted. A slot is valid only under the current stamp, so moving
 //! to the next shading point invalidates the cache without clearing it.
-use light_tree::NodeId;
+use light_tree::{NodeId, QuadLaneCache};
 
 const SLOTS: usize = 1024;
 
@@ -90,5 +90,17 @@ impl<V: Copy> Memo<V> {
         let value = compute(node);
         *s = Slot { node, stamp, value };
         value
+    }
+}
+
+/// The E&K lanes of a shading point's LS pmf replays (`TreeState::with_cached_pmf`).
+impl QuadLaneCache for QuadMemo {
+    #[inline]
+    fn get(&mut self, quad: u32) -> Option<[f32; 4]> {
+        Memo::get(self, quad)
+    }
+    #[inline]
+    fn insert(&mut self, quad: u32, lanes: [f32; 4]) {
+        Memo::insert(self, quad, lanes)
     }
 }

@@ -1,5 +1,6 @@
 //! Light-tree selection (Conty Estevez & Kulla 2018): a single stochastic descent, or
 //! adaptive splitting into a cut with one light drawn per cluster.
+use crate::memo::QuadMemo;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use light_tree::{Cut, LightBounds, LightTree, NodeId, Rescaled, SplitParams};
@@ -7,6 +8,7 @@ use render_core::Vec3;
 use render_core::estimator::ShadingPoint;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
+use std::cell::RefCell;
 use std::collections::VecDeque;
 
 /// The unit of the power the tree aggregates.
@@ -75,26 +77,33 @@ impl TreeSelection {
     }
 }
 
-/// The per-thread buffers of one shading point: the adaptive cut.
+/// The per-thread buffers of one shading point: the adaptive cut, and the quad lanes its pmf
+/// replays read when the state caches them ([`TreeState::with_cached_pmf`]).
 #[derive(Default)]
 pub struct TreeScratch {
     cut: Cut,
     queue: VecDeque<NodeId>,
+    lanes: RefCell<QuadMemo>,
 }
 
 crate::scratch_pool!(TreeScratch, |s| {
     s.cut.nodes.clear();
     s.queue.clear();
+    s.lanes.get_mut().invalidate();
 });
 
 /// The E&K cut of one shading point (none for a single descent), in per-thread scratch.
 ///
 /// The picks and pmf replays descend the tree's four-wide quads
-/// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per two levels. No memo: on `builtin:emissive-mesh` only 338 of 9,724 shading points
+/// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per two levels. No memo
+/// by default: on `builtin:emissive-mesh` only 338 of 9,724 shading points of `tree+bsdf`
 /// replayed a pmf (callgrind, docs/light-tree.md), so its lookups cost more than they saved.
+/// The method replays one per BRDF-aware sample and asks for the memo
+/// ([`TreeState::with_cached_pmf`]).
 pub struct TreeState {
     scratch: Pooled<TreeScratch>,
     split: bool,
+    cached_pmf: bool,
     x: Vec3,
     n: Vec3,
 }
@@ -108,6 +117,24 @@ impl TreeState {
     /// The cut's nodes (sorted DFS ids), if the selection splits.
     pub fn cut(&self) -> Option<&Cut> {
         self.split.then_some(&self.scratch.cut)
+    }
+
+    /// This state's pmf replays keep the quad lanes they evaluate for the next replay (bit for
+    /// bit the same pmfs): for a caller that replays many at one shading point.
+    pub fn with_cached_pmf(mut self) -> Self {
+        self.cached_pmf = true;
+        self
+    }
+
+    /// [`LightTree::pmf_from`] from `start`, through the lane memo if the state keeps one.
+    fn pmf_from(&self, tree: &LightTree, start: NodeId, light: usize) -> f32 {
+        let (x, n) = (self.x, self.n);
+        if self.cached_pmf {
+            let mut lanes = self.scratch.lanes.borrow_mut();
+            tree.pmf_from_cached(start, x, n, light, &mut *lanes)
+        } else {
+            tree.pmf_from(start, x, n, light)
+        }
     }
 }
 
@@ -134,6 +161,7 @@ impl TreeSelection {
         TreeState {
             scratch,
             split,
+            cached_pmf: false,
             x,
             n,
         }
@@ -184,11 +212,10 @@ impl LightSelection for TreeSelection {
 
     fn pmf(&self, state: &TreeState, _: &ShadingPoint, light: u32) -> f32 {
         let Some(tree) = &self.tree else { return 0.0 };
-        let (x, n) = (state.x, state.n);
         match state.cut() {
-            None => tree.pmf_from(tree.root(), x, n, light as usize),
+            None => state.pmf_from(tree, tree.root(), light as usize),
             Some(cut) => match cut.cluster_of(tree, light as usize) {
-                Some(k) => tree.pmf_from(cut.nodes[k], x, n, light as usize),
+                Some(k) => state.pmf_from(tree, cut.nodes[k], light as usize),
                 None => 0.0,
             },
         }

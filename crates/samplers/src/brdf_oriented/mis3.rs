@@ -390,7 +390,7 @@ where
             let table = learned.table.read().unwrap_or_else(|e| e.into_inner());
             LsState::Learned(learned, learned.prepare_with(scene, sp, &table))
         } else if bo.is_some() && self.config.single_ls_at_glossy {
-            LsState::Tree(&self.ls, self.ls.prepare_capped(sp, 1))
+            LsState::Tree(&self.ls, self.ls.prepare_capped(sp, 1).with_cached_pmf())
         } else {
             LsState::Tree(&self.ls, self.ls.prepare(scene, sp))
         };
