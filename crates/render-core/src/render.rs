@@ -7,7 +7,9 @@
 //! is bit-identical whatever the thread count. A time budget stops the claiming of units, so a
 //! render ends at a boundary (full passes, then the first `partial_pixels` pixels of one more)
 //! that depends on the clock but fully determines the image; the budget is overrun by at most
-//! one unit per thread and one reading of the clock, not by a whole pass.
+//! one unit per thread and one reading of the clock, not by a whole pass. Before the first pass
+//! a strategy may ask for a pilot (`crate::pilot`): samples of a sparse set of pixels with
+//! numbers of their own, kept out of the image, that the strategy learns from.
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::emission_rays::{EmissionRays, plan_splits};
@@ -270,31 +272,43 @@ impl PassJob<'_> {
     }
 
     /// Runs `pilot` (`crate::pilot`) on the worker threads and hands the strategy its pixels'
-    /// memory in pixel order; returns what it counted and its camera samples.
-    fn run_pilot(&self, pool: &rayon::ThreadPool, pilot: Pilot) -> (Counters, u64) {
+    /// memory in pixel order; returns what it counted and its camera samples. Under a time
+    /// budget, a chunk of pilot pixels that finds the budget spent is skipped (its pixels keep
+    /// an empty memory), so the pilot overruns the budget by at most one chunk per thread.
+    fn run_pilot(
+        &self,
+        pool: &rayon::ThreadPool,
+        pilot: Pilot,
+        clock: Option<&BudgetClockReader>,
+    ) -> (Counters, u64) {
         let pixels = pilot.pixels(self.grid.width, self.grid.height);
         let mut memory = vec![[0.0f32; PIXEL_MEMORY]; pixels.len()];
-        let per_chunk: Vec<Counters> = pool.install(|| {
+        let per_chunk: Vec<(Counters, u64)> = pool.install(|| {
             memory
                 .par_chunks_mut(UNIT_PIXELS)
                 .zip(pixels.par_chunks(UNIT_PIXELS))
                 .map(|(memory, pixels)| {
                     let mut c = Counters::default();
+                    if clock.is_some_and(|clock| clock.spent(&mut None)) {
+                        return (c, 0);
+                    }
                     for (m, &index) in memory.iter_mut().zip(pixels) {
                         for sample in 0..pilot.samples {
                             self.pilot_sample(pilot, index, sample, m, &mut c);
                         }
                     }
-                    c
+                    (c, pixels.len() as u64 * pilot.samples as u64)
                 })
                 .collect()
         });
         let mut counters = Counters::default();
-        for c in &per_chunk {
+        let mut samples = 0;
+        for (c, n) in &per_chunk {
             counters.merge(c);
+            samples += n;
         }
         self.strategy.end_pilot(&mut memory.iter());
-        (counters, pixels.len() as u64 * pilot.samples as u64)
+        (counters, samples)
     }
 
     /// One pilot sample of pixel `index`: only the strategy's pixel memory keeps anything.
@@ -577,7 +591,7 @@ pub fn render(
     let mut counters = Counters::default();
     let mut pilot_samples = 0;
     if let Some(pilot) = strategy.pilot(grid.width, grid.height) {
-        let (c, n) = job.run_pilot(&pool, pilot);
+        let (c, n) = job.run_pilot(&pool, pilot, clock.as_ref());
         counters.merge(&c);
         pilot_samples = n;
     }
@@ -973,6 +987,24 @@ mod tests {
         }
         assert!(compared > pixels.len() / 2);
         assert!(one.counters.camera_rays > plain.counters.camera_rays);
+    }
+
+    /// A time budget spent before the pilot skips it (the strategy still hears of it, with
+    /// empty memories) and the render still takes its one unit.
+    #[test]
+    fn a_spent_budget_skips_the_pilot() {
+        let scene = test_scene();
+        let strategy = PilotRecorder {
+            pilot: true,
+            seen: Mutex::new(Vec::new()),
+            second_pass: Mutex::new(Vec::new()),
+        };
+        let s = settings(&scene, None, Some(0.0), 1, Sampler::Independent);
+        let image = render(&scene, &strategy, &s, &|_, _| {}).unwrap();
+        assert_eq!(image.pilot_samples, 0);
+        let seen = strategy.seen.into_inner().unwrap();
+        assert!(!seen.is_empty() && seen.iter().all(|m| m[0] == 0.0));
+        assert!(image.partial_pixels > 0 || image.spp > 0);
     }
 
     /// No direct lighting: an image of the emission seen directly alone.
