@@ -18,6 +18,7 @@
 
 use crate::lanes::{Fast, Lanes};
 use crate::quad::QuadNode;
+use crate::query::{MIN_DIST_SQ, MIN_EMIT_COS};
 use crate::{BuildError, FLAG_HALF_SPACE, FLAG_TWO_SIDED, LightTree, Node, NodeExtra};
 use glam::Vec3;
 use rayon::prelude::*;
@@ -29,7 +30,6 @@ const QMAX: u32 = u16::MAX as u32;
 /// Scale of the signed cosine and axis codes.
 const QSIGNED: f32 = i16::MAX as f32;
 
-use crate::query::{MIN_DIST_SQ, MIN_EMIT_COS};
 /// Slack added to θo beyond the axis' quantisation angle (f32 rounding of the decoded axis).
 const AXIS_SLACK: f64 = 1e-5;
 

@@ -233,15 +233,16 @@ fn cached_pmf_replay_matches_the_uncached_one() {
         drop_odd: bool,
     }
     impl crate::QuadLaneCache for Lossy {
-        fn get(&mut self, quad: u32) -> Option<[f32; 4]> {
-            let v = self.map.get(&quad).copied();
-            self.hits += v.is_some() as usize;
-            v
-        }
-        fn insert(&mut self, quad: u32, lanes: [f32; 4]) {
+        fn get_or(&mut self, quad: u32, compute: impl FnOnce() -> [f32; 4]) -> [f32; 4] {
+            if let Some(&v) = self.map.get(&quad) {
+                self.hits += 1;
+                return v;
+            }
+            let lanes = compute();
             if !(self.drop_odd && quad % 2 == 1) {
                 self.map.insert(quad, lanes);
             }
+            lanes
         }
     }
     let mut rng = Pcg32::seed_from_u64(46);

@@ -128,10 +128,8 @@ pub(crate) fn choose<R: DescentRandom>(il: f32, ir: f32, rng: &mut R) -> Option<
 /// A cache of one receiver's E&K quad lanes for [`LightTree::pmf_from_cached`], keyed by quad
 /// index. The lanes are a pure function of (quad, x, n), so a cached value is the recomputed one.
 pub trait QuadLaneCache {
-    /// The lanes of `quad`, if cached.
-    fn get(&mut self, quad: u32) -> Option<[f32; 4]>;
-    /// Keeps `lanes` as the lanes of `quad`.
-    fn insert(&mut self, quad: u32, lanes: [f32; 4]);
+    /// The cached lanes of `quad`, or `compute()` kept for next time.
+    fn get_or(&mut self, quad: u32, compute: impl FnOnce() -> [f32; 4]) -> [f32; 4];
 }
 
 /// [`EkLanes`] through a [`QuadLaneCache`] (the odd-depth pair step, at most once per replay,
@@ -149,12 +147,9 @@ impl<C: QuadLaneCache> StepWeights for CachedEkLanes<'_, C> {
     }
     #[inline(always)]
     fn quad(&mut self, tree: &LightTree, quad: u32) -> [f32; 4] {
-        if let Some(lanes) = self.cache.get(quad) {
-            return lanes;
-        }
-        let lanes = tree.quad_node_importances(quad, self.x, self.n);
-        self.cache.insert(quad, lanes);
-        lanes
+        let (x, n) = (self.x, self.n);
+        self.cache
+            .get_or(quad, || tree.quad_node_importances(quad, x, n))
     }
 }
 

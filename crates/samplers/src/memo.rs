@@ -96,11 +96,7 @@ impl<V: Copy> Memo<V> {
 /// The E&K lanes of a shading point's LS pmf replays (`TreeState::with_cached_pmf`).
 impl QuadLaneCache for QuadMemo {
     #[inline]
-    fn get(&mut self, quad: u32) -> Option<[f32; 4]> {
-        Memo::get(self, quad)
-    }
-    #[inline]
-    fn insert(&mut self, quad: u32, lanes: [f32; 4]) {
-        Memo::insert(self, quad, lanes)
+    fn get_or(&mut self, quad: u32, compute: impl FnOnce() -> [f32; 4]) -> [f32; 4] {
+        Memo::get_or(self, quad, |_| compute())
     }
 }

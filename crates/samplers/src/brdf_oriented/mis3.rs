@@ -154,16 +154,6 @@ impl<C: CapIntegral> Mis3<C> {
         }
         let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
         log.passes += 1;
-        self.adopt_n_max(&mut log, pixel_memory);
-    }
-
-    /// Sets N_max from the tallies of `pixel_memory` (unchanged without a pixel of two samples)
-    /// for pass `log.passes + 1` on, and logs it.
-    fn adopt_n_max(
-        &self,
-        log: &mut NMaxLog,
-        pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>,
-    ) {
         if let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory) {
             self.n_max_now.store(n_max.to_bits(), Ordering::Relaxed);
             if log.changes.last().map(|c| c.1) != Some(n_max) {
@@ -270,13 +260,12 @@ where
         if !self.learns_n_max() {
             return;
         }
+        if let Some(n_max) = EfficiencyTally::best_n_max(pixel_memory) {
+            self.n_max_now.store(n_max.to_bits(), Ordering::Relaxed);
+        }
+        // What pass 1 uses replaces the log's first entry.
         let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
-        // From pass 1 on: the log's first entry is replaced, not followed.
-        log.changes.clear();
-        log.changes.push((1, self.n_max_now()));
-        self.adopt_n_max(&mut log, pixel_memory);
-        let first = log.changes.len() - 1;
-        log.changes.drain(..first);
+        log.changes = vec![(1, self.n_max_now())];
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
