@@ -17,6 +17,8 @@
 //! importance).
 
 use crate::lanes::{Fast, Lanes};
+use crate::oct::OctNode;
+use crate::oct_descent::DescentSimd;
 use crate::quad::QuadNode;
 use crate::query::{MIN_DIST_SQ, MIN_EMIT_COS};
 use crate::{BuildError, FLAG_HALF_SPACE, FLAG_TWO_SIDED, LightTree, Node, NodeExtra};
@@ -218,12 +220,21 @@ pub(crate) struct Compact {
     pub(crate) slot_of: Vec<u32>,
     /// Per pair: the node whose children it holds (`NodeId::MAX` for pair 0, the root's).
     pub(crate) parent: Vec<u32>,
-    /// The four-wide nodes the descents read (`quad.rs`).
+    /// The four-wide nodes a caller-weighted descent reads (`quad.rs`).
     pub(crate) quads: Vec<QuadNode>,
     /// Per node: its quad, `u32::MAX` for leaves and odd-depth nodes.
     pub(crate) quad_of: Vec<u32>,
     /// Per quad: the nodes in its lanes (`NO_NODE` for an empty one), for caller weights.
     pub(crate) quad_nodes: Vec<[crate::NodeId; 4]>,
+    /// The eight-wide nodes the E&K descent reads (`oct.rs`).
+    pub(crate) octs: Vec<OctNode>,
+    /// Per node: its oct, `u32::MAX` for leaves and depths not divisible by 3.
+    pub(crate) oct_of: Vec<u32>,
+    /// Per oct: the nodes in its lanes (`NO_NODE` for an empty one; the tests read it).
+    #[cfg_attr(not(test), allow(dead_code))]
+    pub(crate) oct_nodes: Vec<[crate::NodeId; 8]>,
+    /// The lanes the E&K descent evaluates on.
+    pub(crate) simd: DescentSimd,
 }
 
 impl Compact {
@@ -266,6 +277,7 @@ impl Compact {
             }
         }
         let (quads, quad_of, quad_nodes) = crate::quad::build(nodes, &slots);
+        let (octs, oct_of, oct_nodes) = crate::oct::build(nodes, &slots);
         Ok(Compact {
             quant,
             pairs,
@@ -274,6 +286,10 @@ impl Compact {
             quads,
             quad_of,
             quad_nodes,
+            octs,
+            oct_of,
+            oct_nodes,
+            simd: DescentSimd::detect(),
         })
     }
 }
@@ -281,135 +297,175 @@ impl Compact {
 /// The compact E&K importances `[left, right]` of pair `p` for a receiver at `x` with normal
 /// `n` (`Vec3::ZERO`: no receiver term).
 #[inline(always)]
-pub(crate) fn pair_importance<L: Lanes>(p: &NodePair, q: &Quant, x: Vec3, n: Vec3) -> [f32; 2] {
+pub(crate) fn pair_importance<L: Lanes<4>>(p: &NodePair, q: &Quant, x: Vec3, n: Vec3) -> [f32; 2] {
     let v = quad_importance::<L>(p, p, q, x, n);
     [v[0], v[1]]
 }
 
-/// Four compact slots, lane by lane: two node pairs side by side ([`NodePair`]), or one
-/// [`crate::quad::QuadNode`].
-pub(crate) trait FourSlots {
+/// N compact slots, lane by lane: two node pairs side by side ([`NodePair`]), a
+/// [`crate::quad::QuadNode`] or a [`crate::oct::OctNode`].
+pub(crate) trait Slots<const N: usize> {
     /// Box codes on row `k` (lower x, y, z, then upper x, y, z).
-    fn qbox(&self, k: usize) -> [u16; 4];
+    fn qbox(&self, k: usize) -> [u16; N];
     /// Axis codes on component `k`.
-    fn axis(&self, k: usize) -> [i16; 4];
-    fn cos_o(&self) -> [i16; 4];
-    fn cos_e(&self) -> [i16; 4];
-    fn power(&self) -> [f32; 4];
-    fn flags(&self) -> [u8; 4];
+    fn axis(&self, k: usize) -> [i16; N];
+    fn cos_o(&self) -> [i16; N];
+    fn cos_e(&self) -> [i16; N];
+    fn power(&self) -> [f32; N];
+    fn flags(&self) -> [u8; N];
 }
 
 /// Two pairs as four slots: `[a.left, a.right, b.left, b.right]`.
 pub(crate) struct TwoPairs<'a>(pub(crate) &'a NodePair, pub(crate) &'a NodePair);
 
-impl FourSlots for TwoPairs<'_> {
+impl TwoPairs<'_> {
+    #[inline(always)]
+    fn join<T: Copy>(a: [T; 2], b: [T; 2]) -> [T; 4] {
+        [a[0], a[1], b[0], b[1]]
+    }
+}
+
+impl Slots<4> for TwoPairs<'_> {
     #[inline(always)]
     fn qbox(&self, k: usize) -> [u16; 4] {
-        let (a, b) = (self.0.qbox[k], self.1.qbox[k]);
-        [a[0], a[1], b[0], b[1]]
+        Self::join(self.0.qbox[k], self.1.qbox[k])
     }
     #[inline(always)]
     fn axis(&self, k: usize) -> [i16; 4] {
-        let (a, b) = (self.0.axis[k], self.1.axis[k]);
-        [a[0], a[1], b[0], b[1]]
+        Self::join(self.0.axis[k], self.1.axis[k])
     }
     #[inline(always)]
     fn cos_o(&self) -> [i16; 4] {
-        let (a, b) = (self.0.cos_o, self.1.cos_o);
-        [a[0], a[1], b[0], b[1]]
+        Self::join(self.0.cos_o, self.1.cos_o)
     }
     #[inline(always)]
     fn cos_e(&self) -> [i16; 4] {
-        let (a, b) = (self.0.cos_e, self.1.cos_e);
-        [a[0], a[1], b[0], b[1]]
+        Self::join(self.0.cos_e, self.1.cos_e)
     }
     #[inline(always)]
     fn power(&self) -> [f32; 4] {
-        let (a, b) = (self.0.power, self.1.power);
-        [a[0], a[1], b[0], b[1]]
+        Self::join(self.0.power, self.1.power)
     }
     #[inline(always)]
     fn flags(&self) -> [u8; 4] {
-        let (a, b) = (self.0.flags, self.1.flags);
-        [a[0], a[1], b[0], b[1]]
+        Self::join(self.0.flags, self.1.flags)
     }
 }
 
 /// The compact importances of two pairs at once, `[a.left, a.right, b.left, b.right]`.
 #[inline(always)]
-pub(crate) fn quad_importance<L: Lanes>(
+pub(crate) fn quad_importance<L: Lanes<4>>(
     a: &NodePair,
     b: &NodePair,
     q: &Quant,
     x: Vec3,
     n: Vec3,
 ) -> [f32; 4] {
-    slots_importance::<L, _>(&TwoPairs(a, b), q, x, n)
+    slots_importance::<4, L, _>(&TwoPairs(a, b), q, x, n)
 }
 
-/// The compact importances of four slots: the exact importance's formula, term for term, on
+/// The compact importances of N slots: the exact importance's formula, term for term, on
 /// the decoded bounds, with selects instead of early exits. Each lane only sees its own node,
-/// so a node's value is the same bits in any slot of any pair or quad.
+/// so a node's value is the same bits in any slot of any pair, quad or oct, on any lanes.
 #[inline(always)]
-pub(crate) fn slots_importance<L: Lanes, S: FourSlots>(
+pub(crate) fn slots_importance<const N: usize, L: Lanes<N>, S: Slots<N>>(
     s: &S,
     q: &Quant,
     x: Vec3,
     n: Vec3,
-) -> [f32; 4] {
-    slots_evaluated::<L, S>(s, q, x, n).importance
+) -> [f32; N] {
+    slots_evaluated::<N, L, S>(s, q, x, n).importance
 }
 
 /// What [`slots_importance`] computes on the way, lane by lane.
-pub(crate) struct SlotsEvaluated {
+pub(crate) struct SlotsEvaluated<const N: usize> {
     /// The compact importance.
-    pub(crate) importance: [f32; 4],
+    pub(crate) importance: [f32; N],
     /// The decoded box centre − x, per axis.
-    pub(crate) to_centre: [[f32; 4]; 3],
+    pub(crate) to_centre: [[f32; N]; 3],
     /// The decoded box's half-diagonal squared (the bounding sphere's radius²).
-    pub(crate) radius_sq: [f32; 4],
+    pub(crate) radius_sq: [f32; N],
+}
+
+// Helpers of `slots_evaluated` as functions, not closures or array maps: inside the AVX
+// descent (a `#[target_feature]` function) LLVM inlines these, and with them the intrinsics;
+// closures were left as calls there, each intrinsic a call too.
+
+#[inline(always)]
+fn dot3<L: Copy + std::ops::Add<Output = L> + std::ops::Mul<Output = L>>(
+    a: &[L; 3],
+    b: &[L; 3],
+) -> L {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+#[inline(always)]
+fn from_u16<const N: usize, L: Lanes<N>>(c: [u16; N]) -> L {
+    let mut f = [0.0f32; N];
+    for k in 0..N {
+        f[k] = c[k] as f32;
+    }
+    L::load(f)
+}
+
+#[inline(always)]
+fn from_i16<const N: usize, L: Lanes<N>>(c: [i16; N]) -> L {
+    let mut f = [0.0f32; N];
+    for k in 0..N {
+        f[k] = c[k] as f32;
+    }
+    L::load(f)
+}
+
+#[inline(always)]
+fn cosines<const N: usize, L: Lanes<N>>(c: [i16; N]) -> L {
+    let mut f = [0.0f32; N];
+    for k in 0..N {
+        f[k] = decode_cos(c[k]);
+    }
+    L::load(f)
+}
+
+/// The lanes whose `flags` have `flag`, as a mask.
+#[inline(always)]
+fn flag_mask<const N: usize, L: Lanes<N>>(flags: &[u8; N], flag: u8) -> L {
+    let mut f = [0.0f32; N];
+    for k in 0..N {
+        f[k] = f32::from_bits(if flags[k] & flag != 0 { u32::MAX } else { 0 });
+    }
+    L::load(f)
 }
 
 /// [`slots_importance`] with its decoded centres and radii (unused outputs cost nothing once
 /// inlined).
 #[inline(always)]
-pub(crate) fn slots_evaluated<L: Lanes, S: FourSlots>(
+pub(crate) fn slots_evaluated<const N: usize, L: Lanes<N>, S: Slots<N>>(
     s: &S,
     q: &Quant,
     x: Vec3,
     n: Vec3,
-) -> SlotsEvaluated {
-    let code = |c: [u16; 4]| L::quad(c[0] as f32, c[1] as f32, c[2] as f32, c[3] as f32);
+) -> SlotsEvaluated<N> {
     let half_l = L::splat(0.5);
     let mut c = [L::splat(0.0); 3];
     let mut h = [L::splat(0.0); 3];
     for k in 0..3 {
         let (o, st) = (L::splat(q.origin[k]), L::splat(q.step[k]));
-        let lo = o + code(s.qbox(k)) * st;
-        let hi = o + code(s.qbox(k + 3)) * st;
+        let lo = o + from_u16::<N, L>(s.qbox(k)) * st;
+        let hi = o + from_u16::<N, L>(s.qbox(k + 3)) * st;
         c[k] = (lo + hi) * half_l - L::splat(x[k]);
         h[k] = (hi - lo) * half_l;
     }
-    let dot3 = |a: &[L; 3], b: &[L; 3]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let zero = L::splat(0.0);
     let one = L::splat(1.0);
 
-    let ax = [0, 1, 2].map(|k| {
-        let u = s.axis(k);
-        L::quad(u[0] as f32, u[1] as f32, u[2] as f32, u[3] as f32)
-    });
+    let ax = [
+        from_i16::<N, L>(s.axis(0)),
+        from_i16::<N, L>(s.axis(1)),
+        from_i16::<N, L>(s.axis(2)),
+    ];
     let flags = s.flags();
-    let flag = |f: u8| L::mask(flags.map(|v| v & f != 0));
-    let cosines = |u: [i16; 4]| {
-        L::quad(
-            decode_cos(u[0]),
-            decode_cos(u[1]),
-            decode_cos(u[2]),
-            decode_cos(u[3]),
-        )
-    };
     let inv_len = one / dot3(&ax, &ax).sqrt();
-    let ax = ax.map(|v| v * inv_len);
+    let ax = [ax[0] * inv_len, ax[1] * inv_len, ax[2] * inv_len];
 
     let has_n = n != Vec3::ZERO;
     let nv = [L::splat(n.x), L::splat(n.y), L::splat(n.z)];
@@ -423,8 +479,10 @@ pub(crate) fn slots_evaluated<L: Lanes, S: FourSlots>(
         ];
         dark = (dot3(&nv, &c) + dot3(&na, &h)).le(zero);
     }
-    let half_space = flag(FLAG_HALF_SPACE);
-    let behind = (dot3(&ax, &c.map(|v| zero - v)) + dot3(&ax.map(L::abs), &h)).le(zero);
+    let half_space = flag_mask::<N, L>(&flags, FLAG_HALF_SPACE);
+    let to_x = [zero - c[0], zero - c[1], zero - c[2]];
+    let ax_abs = [ax[0].abs(), ax[1].abs(), ax[2].abs()];
+    let behind = (dot3(&ax, &to_x) + dot3(&ax_abs, &h)).le(zero);
     dark = dark.or(half_space.and(behind));
 
     let d2 = dot3(&c, &c);
@@ -432,17 +490,18 @@ pub(crate) fn slots_evaluated<L: Lanes, S: FourSlots>(
     let d2c = d2.max(L::splat(0.25) * r2).max(L::splat(MIN_DIST_SQ));
     let inside = d2.le(r2);
     let inv_d = one / d2.sqrt();
-    let w = c.map(|v| v * inv_d);
     let sin_u = (r2.sqrt() * inv_d).min(one);
     let cos_u = (one - sin_u * sin_u).max(zero).sqrt();
 
     // Emitter: θ between the axis and x − c.
-    let mut cos_t = zero - dot3(&ax, &w);
-    let two_sided = flag(FLAG_TWO_SIDED);
+    // The dot products with c run beside the square root and the division (a shorter chain
+    // than normalising c first).
+    let mut cos_t = zero - dot3(&ax, &c) * inv_d;
+    let two_sided = flag_mask::<N, L>(&flags, FLAG_TWO_SIDED);
     cos_t = L::select(two_sided, cos_t.abs(), cos_t);
     let sin_t = (one - cos_t * cos_t).max(zero).sqrt();
-    let cos_o = cosines(s.cos_o());
-    let cos_e = cosines(s.cos_e());
+    let cos_o = cosines::<N, L>(s.cos_o());
+    let cos_e = cosines::<N, L>(s.cos_e());
     let sin_o = (one - cos_o * cos_o).max(zero).sqrt();
     let within = cos_t.ge(cos_o);
     let cos_x = L::select(within, one, cos_t * cos_o + sin_t * sin_o);
@@ -453,7 +512,7 @@ pub(crate) fn slots_evaluated<L: Lanes, S: FourSlots>(
 
     // Receiver: θi between n and c − x.
     let recv = if has_n {
-        let cos_i = dot3(&nv, &w);
+        let cos_i = dot3(&nv, &c) * inv_d;
         let sin_i = (one - cos_i * cos_i).max(zero).sqrt();
         let recv = L::select(cos_i.ge(cos_u), one, cos_i * cos_u + sin_i * sin_u);
         cone_dark = cone_dark.or(recv.le(zero));
@@ -462,13 +521,12 @@ pub(crate) fn slots_evaluated<L: Lanes, S: FourSlots>(
         one
     };
 
-    let pw = s.power();
-    let power = L::quad(pw[0], pw[1], pw[2], pw[3]);
-    let outside = power * emit * recv / d2c;
-    let value = L::select(inside, power / d2c, cone_dark.andnot(outside));
+    let near = L::load(s.power()) / d2c;
+    let outside = near * emit * recv;
+    let value = L::select(inside, near, cone_dark.andnot(outside));
     SlotsEvaluated {
         importance: dark.andnot(value).out(),
-        to_centre: c.map(L::out),
+        to_centre: [c[0].out(), c[1].out(), c[2].out()],
         radius_sq: r2.out(),
     }
 }
@@ -488,18 +546,11 @@ impl LightTree {
         quad_importance::<Fast>(&c.pairs[a as usize], &c.pairs[b as usize], &c.quant, x, n)
     }
 
-    /// Compact importances of the four lanes of quad `quad`.
-    #[inline(always)]
-    pub(crate) fn quad_node_importances(&self, quad: u32, x: Vec3, n: Vec3) -> [f32; 4] {
-        let c = &self.compact;
-        slots_importance::<Fast, _>(&c.quads[quad as usize], &c.quant, x, n)
-    }
-
     /// What a caller's weight of quad `quad`'s four nodes can reuse at `x` (see
     /// [`crate::QuadView`]).
     pub fn quad_view(&self, quad: u32, x: Vec3) -> crate::QuadView {
         let c = &self.compact;
-        let e = slots_evaluated::<Fast, _>(&c.quads[quad as usize], &c.quant, x, Vec3::ZERO);
+        let e = slots_evaluated::<4, Fast, _>(&c.quads[quad as usize], &c.quant, x, Vec3::ZERO);
         crate::QuadView {
             to_centre: e.to_centre,
             radius_sq: e.radius_sq,

@@ -3,9 +3,9 @@
 //! bit-identical, and the compact descents equal to the generic ones bit for bit.
 
 use crate::compact::{LEAF_BIT, pair_importance, quad_importance, slots_importance};
-use crate::lanes::{Fast, Scalar4};
-use crate::tests::{Layout, four_wide_importance, rand_lights, rand_receiver, tree_configs};
-use crate::{LightTree, NodeId, Rescaled};
+use crate::lanes::{Fast, Fast8, Portable, Scalar4};
+use crate::tests::{Layout, eight_wide_importance, rand_lights, rand_receiver, tree_configs};
+use crate::{DescentSimd, LightTree, NodeId, Rescaled};
 use rand::{RngExt, SeedableRng};
 use rand_pcg::Pcg32;
 
@@ -143,8 +143,8 @@ fn quads_hold_the_grandchildren() {
                     continue;
                 }
                 let quad = &c.quads[q as usize];
-                let fast = slots_importance::<Fast, _>(quad, &c.quant, x, n);
-                let portable = slots_importance::<Scalar4, _>(quad, &c.quant, x, n);
+                let fast = slots_importance::<4, Fast, _>(quad, &c.quant, x, n);
+                let portable = slots_importance::<4, Scalar4, _>(quad, &c.quant, x, n);
                 assert_eq!(fast.map(f32::to_bits), portable.map(f32::to_bits));
                 for (half, child) in [(0, l), (1, r)] {
                     let lanes: [Option<NodeId>; 2] = match tree.node(child).children(child) {
@@ -170,19 +170,97 @@ fn quads_hold_the_grandchildren() {
     }
 }
 
-/// `sample_from` / `pmf_from` equal `sample_subtree` / `pmf_subtree` under
-/// `LightTree::importance` with each odd-depth interior node weighed as the sum of its
-/// children's (the four-wide descent, `quad.rs`), bit for bit, from random start nodes;
-/// `child_importances` equals the two `importance` calls.
+/// Every interior node at a depth divisible by 3 has an oct whose lanes are its
+/// great-grandchildren in branch-bit order (a leaf above that depth in the first lane of its
+/// range, beside empty lanes of importance 0), each lane the same bits as `importance` of its
+/// node on every lane implementation, with the right codes.
 #[test]
-fn compact_descent_matches_the_generic_one() {
-    let mut rng = Pcg32::seed_from_u64(44);
+fn octs_hold_the_great_grandchildren() {
+    let mut rng = Pcg32::seed_from_u64(47);
     for (tree, _) in trees(&mut rng) {
+        let c = &tree.compact;
+        let code = |id: NodeId| match tree.node(id).light() {
+            Some(l) => LEAF_BIT | l as u32,
+            None => c.oct_of[id as usize],
+        };
+        // The lanes under `id` by branch bits: (lane, node), leaves in their range's first.
+        fn lanes_of(
+            tree: &LightTree,
+            id: NodeId,
+            first: usize,
+            span: usize,
+            out: &mut Vec<(usize, NodeId)>,
+        ) {
+            match tree.node(id).children(id) {
+                Some((l, r)) if span > 1 => {
+                    lanes_of(tree, l, first, span / 2, out);
+                    lanes_of(tree, r, first + span / 2, span / 2, out);
+                }
+                _ => out.push((first, id)),
+            }
+        }
+        for _ in 0..10 {
+            let (x, n) = rand_receiver(&mut rng);
+            for id in 0..tree.nodes().len() as NodeId {
+                let node = tree.node(id);
+                let o = c.oct_of[id as usize];
+                if node.is_leaf() || node.depth() % 3 != 0 {
+                    assert_eq!(o, u32::MAX);
+                    continue;
+                }
+                let fast = tree.oct_lanes::<Fast8>(o, x, n);
+                let portable = tree.oct_lanes::<Portable<8>>(o, x, n);
+                assert_eq!(fast.map(f32::to_bits), portable.map(f32::to_bits));
+                #[cfg(target_arch = "x86_64")]
+                if DescentSimd::detect() == DescentSimd::Avx2 {
+                    // SAFETY: the CPU has AVX2.
+                    let avx = unsafe { avx_lanes(&tree, o, x, n) };
+                    assert_eq!(avx.map(f32::to_bits), portable.map(f32::to_bits));
+                }
+                let (l, r) = node.children(id).unwrap();
+                let mut lanes = Vec::new();
+                lanes_of(&tree, l, 0, 4, &mut lanes);
+                lanes_of(&tree, r, 4, 4, &mut lanes);
+                let oct = &c.octs[o as usize];
+                let mut filled = [false; 8];
+                for (lane, g) in lanes {
+                    filled[lane] = true;
+                    assert_eq!(fast[lane].to_bits(), tree.importance(g, x, n).to_bits());
+                    assert_eq!(oct.child[lane], code(g));
+                    assert_eq!(c.oct_nodes[o as usize][lane], g);
+                }
+                for lane in (0..8).filter(|&k| !filled[k]) {
+                    assert_eq!(fast[lane], 0.0);
+                    assert_eq!(oct.child[lane], LEAF_BIT);
+                    assert_eq!(c.oct_nodes[o as usize][lane], crate::NO_NODE);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn avx_lanes(tree: &LightTree, oct: u32, x: glam::Vec3, n: glam::Vec3) -> [f32; 8] {
+    tree.oct_lanes::<crate::lanes::Avx8>(oct, x, n)
+}
+
+/// `sample_from` / `pmf_from` sample the binary descent under `LightTree::importance` with
+/// interior nodes at depths not divisible by 3 weighed as the sum of their children's (the
+/// eight-wide descent, `oct.rs`): the replayed pmf is `pmf_subtree`'s under that weight to
+/// f32 rounding, from random start nodes; a sample's pmf is its replay's, bit for bit; and
+/// AVX and the forced fallback give the same lights and pmfs. `child_importances` equals the
+/// two `importance` calls.
+#[test]
+fn compact_descent_samples_the_eight_wide_weights() {
+    let mut rng = Pcg32::seed_from_u64(44);
+    for (mut tree, _) in trees(&mut rng) {
+        let mut fallback = tree.clone();
+        fallback.set_descent_simd(DescentSimd::Fallback).unwrap();
         for _ in 0..100 {
             let (x, n) = rand_receiver(&mut rng);
             let start = rng.random_range(0..tree.nodes().len() as NodeId);
             let imp = |c| tree.importance(c, x, n);
-            let four_wide = |c| four_wide_importance(&tree, c, x, n);
             if let Some((l, r)) = tree.node(start).children(start) {
                 let ci = tree.child_importances(start, x, n).unwrap();
                 assert_eq!(ci.map(f32::to_bits), [imp(l).to_bits(), imp(r).to_bits()]);
@@ -203,46 +281,56 @@ fn compact_descent_matches_the_generic_one() {
                     assert_eq!((a >> 1, a & 1), (b >> 1, 1 - (b & 1)));
                 }
             }
-            let u = rng.random::<u64>();
-            let a = tree.sample_from(start, x, n, &mut Rescaled(u));
-            let b = tree.sample_subtree(start, four_wide, &mut Rescaled(u));
-            assert_eq!(
-                a.map(|(l, p)| (l, p.to_bits())),
-                b.map(|(l, p)| (l, p.to_bits()))
-            );
-            if let Some((l, p)) = a {
-                assert_eq!(tree.pmf_from(start, x, n, l).to_bits(), p.to_bits());
-            }
-            for light in 0..tree.num_lights().min(64) {
+            for _ in 0..4 {
+                let u = rng.random::<u64>();
+                let a = tree.sample_from(start, x, n, &mut Rescaled(u));
+                let b = fallback.sample_from(start, x, n, &mut Rescaled(u));
                 assert_eq!(
-                    tree.pmf_from(start, x, n, light).to_bits(),
-                    tree.pmf_subtree(start, four_wide, light).to_bits()
+                    a.map(|(l, p)| (l, p.to_bits())),
+                    b.map(|(l, p)| (l, p.to_bits()))
+                );
+                if let Some((l, p)) = a {
+                    assert_eq!(tree.pmf_from(start, x, n, l).to_bits(), p.to_bits());
+                }
+            }
+            let eight_wide = |c| eight_wide_importance(&tree, start, c, x, n);
+            for light in 0..tree.num_lights().min(64) {
+                let p = tree.pmf_from(start, x, n, light);
+                assert_eq!(p.to_bits(), fallback.pmf_from(start, x, n, light).to_bits());
+                let want = tree.pmf_subtree(start, eight_wide, light);
+                assert!(
+                    (p - want).abs() <= 1e-5 * want + 1e-12,
+                    "start {start} light {light}: {p} vs {want}"
                 );
             }
         }
+        // Forcing AVX2 works exactly where the CPU has it.
+        assert_eq!(
+            tree.set_descent_simd(DescentSimd::Avx2).is_ok(),
+            DescentSimd::detect() == DescentSimd::Avx2
+        );
     }
 }
 
 /// `pmf_from_cached` is `pmf_from` bit for bit, whether its cache starts empty, holds every
-/// quad it reads, or forgets some between replays (a direct-mapped cache evicts).
+/// oct it reads, or forgets some between replays (a direct-mapped cache evicts).
 #[test]
 fn cached_pmf_replay_matches_the_uncached_one() {
     struct Lossy {
-        map: std::collections::HashMap<u32, [f32; 4]>,
+        map: std::collections::HashMap<u32, [f32; 8]>,
         hits: usize,
         drop_odd: bool,
     }
-    impl crate::QuadLaneCache for Lossy {
-        fn get_or(&mut self, quad: u32, compute: impl FnOnce() -> [f32; 4]) -> [f32; 4] {
-            if let Some(&v) = self.map.get(&quad) {
-                self.hits += 1;
-                return v;
+    impl crate::LaneCache for Lossy {
+        fn get(&mut self, oct: u32) -> Option<[f32; 8]> {
+            let v = self.map.get(&oct).copied();
+            self.hits += v.is_some() as usize;
+            v
+        }
+        fn put(&mut self, oct: u32, lanes: [f32; 8]) {
+            if !(self.drop_odd && oct % 2 == 1) {
+                self.map.insert(oct, lanes);
             }
-            let lanes = compute();
-            if !(self.drop_odd && quad % 2 == 1) {
-                self.map.insert(quad, lanes);
-            }
-            lanes
         }
     }
     let mut rng = Pcg32::seed_from_u64(46);
@@ -266,7 +354,7 @@ fn cached_pmf_replay_matches_the_uncached_one() {
                     }
                 }
                 // The second round read every quad the first one kept.
-                assert!(tree.num_quads() < 2 || cache.map.is_empty() || cache.hits > 0);
+                assert!(cache.map.is_empty() || cache.hits > 0);
             }
         }
     }

@@ -1,21 +1,23 @@
-//! Four nodes' arithmetic at once: a four-lane f32 vector whose lanes hold the two children of
-//! one node pair (lanes 0, 1) and of another (lanes 2, 3). Lanes never mix, so a node's value
-//! does not depend on what shares the vector. SSE2 on x86_64 (always present
-//! there), plain arrays elsewhere; both use only IEEE-exact operations (+ − × ÷ √, min, max,
-//! compares, bit selects) in the same order, so both give the same bits. Masks are lanes of
-//! all ones or all zeros, in the same type.
+//! N nodes' arithmetic at once: an N-lane f32 vector whose lanes hold N nodes (a pair's two
+//! children beside another pair's, a quad's four grandchildren, an oct's eight great-
+//! grandchildren). Lanes never mix, so a node's value does not depend on what shares the
+//! vector. Four lanes: SSE2 on x86_64 (always present there); eight: AVX where the CPU has it
+//! (chosen at run time, `DescentSimd`), two SSE2 halves otherwise; plain arrays elsewhere.
+//! All use only IEEE-exact operations (+ − × ÷ √, min, max, compares, bit selects) in the
+//! same order, so all give the same bits. Masks are lanes of all ones or all zeros, in the
+//! same type.
 
 // The portable lanes only run elsewhere, and in the tests that compare them with SSE2.
 #![cfg_attr(all(target_arch = "x86_64", not(test)), allow(dead_code))]
 
 use std::ops::{Add, Div, Mul, Sub};
 
-/// The operations the pair importance needs.
-pub(crate) trait Lanes:
+/// The operations the compact importance needs, on `N` lanes.
+pub(crate) trait Lanes<const N: usize>:
     Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
 {
-    /// `[a, b, c, d]`.
-    fn quad(a: f32, b: f32, c: f32, d: f32) -> Self;
+    /// The lanes `v`.
+    fn load(v: [f32; N]) -> Self;
     fn splat(v: f32) -> Self;
     fn sqrt(self) -> Self;
     /// `self < o ? self : o` per lane (SSE `minps`).
@@ -29,34 +31,35 @@ pub(crate) trait Lanes:
     fn or(self, o: Self) -> Self;
     /// `!self & o`.
     fn andnot(self, o: Self) -> Self;
-    /// The four lanes.
-    fn out(self) -> [f32; 4];
+    /// The lanes.
+    fn out(self) -> [f32; N];
     /// `mask ? a : b` per lane.
     #[inline(always)]
     fn select(mask: Self, a: Self, b: Self) -> Self {
         mask.and(a).or(mask.andnot(b))
     }
-    /// A mask from four flags.
+    /// A mask from N flags.
     #[inline(always)]
-    fn mask(f: [bool; 4]) -> Self {
-        let m = |b: bool| f32::from_bits(if b { u32::MAX } else { 0 });
-        Self::quad(m(f[0]), m(f[1]), m(f[2]), m(f[3]))
+    fn mask(f: [bool; N]) -> Self {
+        Self::load(f.map(|b| f32::from_bits(if b { u32::MAX } else { 0 })))
     }
 }
 
-/// The portable lanes (and the reference that the SSE2 lanes are tested against).
+/// The portable lanes (and the reference that the SIMD lanes are tested against).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Scalar4(pub [f32; 4]);
+pub(crate) struct Portable<const N: usize>(pub [f32; N]);
 
-impl Scalar4 {
+/// Four portable lanes.
+pub(crate) type Scalar4 = Portable<4>;
+
+impl<const N: usize> Portable<N> {
     #[inline(always)]
     fn map(self, f: impl Fn(f32) -> f32) -> Self {
-        Scalar4(self.0.map(f))
+        Portable(self.0.map(f))
     }
     #[inline(always)]
     fn zip(self, o: Self, f: impl Fn(f32, f32) -> f32) -> Self {
-        let (a, b) = (self.0, o.0);
-        Scalar4([f(a[0], b[0]), f(a[1], b[1]), f(a[2], b[2]), f(a[3], b[3])])
+        Portable(std::array::from_fn(|k| f(self.0[k], o.0[k])))
     }
     #[inline(always)]
     fn bits(self, o: Self, f: impl Fn(u32, u32) -> u32) -> Self {
@@ -64,32 +67,32 @@ impl Scalar4 {
     }
 }
 
-macro_rules! scalar_op {
+macro_rules! portable_op {
     ($tr:ident, $f:ident, $op:tt) => {
-        impl $tr for Scalar4 {
-            type Output = Scalar4;
+        impl<const N: usize> $tr for Portable<N> {
+            type Output = Portable<N>;
             #[inline(always)]
-            fn $f(self, o: Scalar4) -> Scalar4 {
+            fn $f(self, o: Portable<N>) -> Portable<N> {
                 self.zip(o, |a, b| a $op b)
             }
         }
     };
 }
-scalar_op!(Add, add, +);
-scalar_op!(Sub, sub, -);
-scalar_op!(Mul, mul, *);
-scalar_op!(Div, div, /);
+portable_op!(Add, add, +);
+portable_op!(Sub, sub, -);
+portable_op!(Mul, mul, *);
+portable_op!(Div, div, /);
 
 const ONES: u32 = u32::MAX;
 
-impl Lanes for Scalar4 {
+impl<const N: usize> Lanes<N> for Portable<N> {
     #[inline(always)]
-    fn quad(a: f32, b: f32, c: f32, d: f32) -> Self {
-        Scalar4([a, b, c, d])
+    fn load(v: [f32; N]) -> Self {
+        Portable(v)
     }
     #[inline(always)]
     fn splat(v: f32) -> Self {
-        Scalar4([v; 4])
+        Portable([v; N])
     }
     #[inline(always)]
     fn sqrt(self) -> Self {
@@ -128,16 +131,91 @@ impl Lanes for Scalar4 {
         self.bits(o, |a, b| !a & b)
     }
     #[inline(always)]
-    fn out(self) -> [f32; 4] {
+    fn out(self) -> [f32; N] {
         self.0
     }
 }
 
-#[cfg(target_arch = "x86_64")]
-pub(crate) use sse::Sse4;
+/// Eight lanes as two four-lane halves (the fallback where AVX is missing).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Pair<L>(L, L);
+
+macro_rules! pair_op {
+    ($tr:ident, $f:ident) => {
+        impl<L: Lanes<4>> $tr for Pair<L> {
+            type Output = Pair<L>;
+            #[inline(always)]
+            fn $f(self, o: Pair<L>) -> Pair<L> {
+                Pair(self.0.$f(o.0), self.1.$f(o.1))
+            }
+        }
+    };
+}
+pair_op!(Add, add);
+pair_op!(Sub, sub);
+pair_op!(Mul, mul);
+pair_op!(Div, div);
+
+impl<L: Lanes<4>> Lanes<8> for Pair<L> {
+    #[inline(always)]
+    fn load(v: [f32; 8]) -> Self {
+        Pair(
+            L::load([v[0], v[1], v[2], v[3]]),
+            L::load([v[4], v[5], v[6], v[7]]),
+        )
+    }
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        Pair(L::splat(v), L::splat(v))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Pair(self.0.sqrt(), self.1.sqrt())
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        Pair(self.0.min(o.0), self.1.min(o.1))
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        Pair(self.0.max(o.0), self.1.max(o.1))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Pair(self.0.abs(), self.1.abs())
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> Self {
+        Pair(self.0.le(o.0), self.1.le(o.1))
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> Self {
+        Pair(self.0.ge(o.0), self.1.ge(o.1))
+    }
+    #[inline(always)]
+    fn and(self, o: Self) -> Self {
+        Pair(self.0.and(o.0), self.1.and(o.1))
+    }
+    #[inline(always)]
+    fn or(self, o: Self) -> Self {
+        Pair(self.0.or(o.0), self.1.or(o.1))
+    }
+    #[inline(always)]
+    fn andnot(self, o: Self) -> Self {
+        Pair(self.0.andnot(o.0), self.1.andnot(o.1))
+    }
+    #[inline(always)]
+    fn out(self) -> [f32; 8] {
+        let (a, b) = (self.0.out(), self.1.out());
+        [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]]
+    }
+}
 
 #[cfg(target_arch = "x86_64")]
-mod sse {
+pub(crate) use x86::{Avx8, Sse4};
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
     use super::Lanes;
     use std::arch::x86_64::*;
     use std::ops::{Add, Div, Mul, Sub};
@@ -146,28 +224,40 @@ mod sse {
     #[derive(Clone, Copy, Debug)]
     pub(crate) struct Sse4(__m128);
 
-    macro_rules! sse_op {
-        ($tr:ident, $f:ident, $intr:ident) => {
-            impl $tr for Sse4 {
-                type Output = Sse4;
+    /// AVX lanes. Only constructed inside a `#[target_feature(enable = "avx2")]` function
+    /// that runs after the CPU was found to have AVX2 (`DescentSimd::detect`), where these
+    /// `#[inline(always)]` methods inline and their intrinsics become single instructions.
+    #[derive(Clone, Copy, Debug)]
+    pub(crate) struct Avx8(__m256);
+
+    macro_rules! simd_op {
+        ($ty:ident, $tr:ident, $f:ident, $intr:ident) => {
+            impl $tr for $ty {
+                type Output = $ty;
                 #[inline(always)]
-                fn $f(self, o: Sse4) -> Sse4 {
-                    // SAFETY: SSE2 is always available on x86_64.
-                    Sse4(unsafe { $intr(self.0, o.0) })
+                fn $f(self, o: $ty) -> $ty {
+                    // SAFETY: SSE2 is always available on x86_64; `Avx8` exists only where
+                    // AVX2 was detected (see its doc).
+                    $ty(unsafe { $intr(self.0, o.0) })
                 }
             }
         };
     }
-    sse_op!(Add, add, _mm_add_ps);
-    sse_op!(Sub, sub, _mm_sub_ps);
-    sse_op!(Mul, mul, _mm_mul_ps);
-    sse_op!(Div, div, _mm_div_ps);
+    simd_op!(Sse4, Add, add, _mm_add_ps);
+    simd_op!(Sse4, Sub, sub, _mm_sub_ps);
+    simd_op!(Sse4, Mul, mul, _mm_mul_ps);
+    simd_op!(Sse4, Div, div, _mm_div_ps);
+    simd_op!(Avx8, Add, add, _mm256_add_ps);
+    simd_op!(Avx8, Sub, sub, _mm256_sub_ps);
+    simd_op!(Avx8, Mul, mul, _mm256_mul_ps);
+    simd_op!(Avx8, Div, div, _mm256_div_ps);
 
-    // SAFETY (every block below): SSE2 is always available on x86_64; no memory is touched.
-    impl Lanes for Sse4 {
+    // SAFETY (every block below): SSE2 is always available on x86_64; no memory is touched
+    // but the arrays passed in and out.
+    impl Lanes<4> for Sse4 {
         #[inline(always)]
-        fn quad(a: f32, b: f32, c: f32, d: f32) -> Self {
-            Sse4(unsafe { _mm_set_ps(d, c, b, a) })
+        fn load(v: [f32; 4]) -> Self {
+            Sse4(unsafe { _mm_loadu_ps(v.as_ptr()) })
         }
         #[inline(always)]
         fn splat(v: f32) -> Self {
@@ -216,11 +306,70 @@ mod sse {
             out
         }
     }
+
+    // SAFETY (every block below): `Avx8` exists only where AVX2 was detected (its doc); no
+    // memory is touched but the arrays passed in and out. The comparisons use the ordered,
+    // non-signalling predicates of SSE's `cmpleps` / `cmpgeps` (false on NaN), and min / max
+    // return the second operand on NaN as SSE's do.
+    impl Lanes<8> for Avx8 {
+        #[inline(always)]
+        fn load(v: [f32; 8]) -> Self {
+            Avx8(unsafe { _mm256_loadu_ps(v.as_ptr()) })
+        }
+        #[inline(always)]
+        fn splat(v: f32) -> Self {
+            Avx8(unsafe { _mm256_set1_ps(v) })
+        }
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            Avx8(unsafe { _mm256_sqrt_ps(self.0) })
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            Avx8(unsafe { _mm256_min_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            Avx8(unsafe { _mm256_max_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            Avx8(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0) })
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> Self {
+            Avx8(unsafe { _mm256_cmp_ps::<_CMP_LE_OS>(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn ge(self, o: Self) -> Self {
+            Avx8(unsafe { _mm256_cmp_ps::<_CMP_GE_OS>(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn and(self, o: Self) -> Self {
+            Avx8(unsafe { _mm256_and_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn or(self, o: Self) -> Self {
+            Avx8(unsafe { _mm256_or_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn andnot(self, o: Self) -> Self {
+            Avx8(unsafe { _mm256_andnot_ps(self.0, o.0) })
+        }
+        #[inline(always)]
+        fn out(self) -> [f32; 8] {
+            let mut out = [0.0f32; 8];
+            unsafe { _mm256_storeu_ps(out.as_mut_ptr(), self.0) };
+            out
+        }
+    }
 }
 
-/// The lanes the queries run on.
+/// The four lanes the queries run on.
 #[cfg(target_arch = "x86_64")]
 pub(crate) type Fast = Sse4;
-/// The lanes the queries run on.
+/// The four lanes the queries run on.
 #[cfg(not(target_arch = "x86_64"))]
 pub(crate) type Fast = Scalar4;
+/// Eight lanes without AVX: two halves of [`Fast`].
+pub(crate) type Fast8 = Pair<Fast>;

@@ -73,6 +73,8 @@ mod compact;
 mod compact_tests;
 mod cone;
 mod lanes;
+mod oct;
+mod oct_descent;
 mod quad;
 mod quad_descent;
 mod query;
@@ -85,10 +87,10 @@ mod split_tests;
 mod tests;
 
 pub use cone::Cone;
+pub use oct_descent::{DescentSimd, LaneCache};
 pub use quad_descent::{NO_NODE, QuadView, QuadWeights};
 pub use query::{
-    Cut, DescentRandom, Fresh, MIN_DIST_SQ, MIN_EMIT_COS, QuadLaneCache, Rescaled, SplitCriterion,
-    SplitParams,
+    Cut, DescentRandom, Fresh, MIN_DIST_SQ, MIN_EMIT_COS, Rescaled, SplitCriterion, SplitParams,
 };
 pub use sg::{
     SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,

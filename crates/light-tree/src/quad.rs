@@ -9,7 +9,7 @@
 //! by its own importance: the binary descent in which an odd-depth interior node weighs as
 //! the sum of its children's importances (see `compact_tests.rs`).
 
-use crate::compact::{FourSlots, LEAF_BIT, Slot};
+use crate::compact::{LEAF_BIT, Slot, Slots};
 use crate::{NO_NODE, Node, NodeId};
 
 /// Four slots, structure-of-arrays, lanes `[left.l, left.r, right.l, right.r]`; 128 bytes.
@@ -49,7 +49,7 @@ impl QuadNode {
     }
 }
 
-impl FourSlots for QuadNode {
+impl Slots<4> for QuadNode {
     #[inline(always)]
     fn qbox(&self, k: usize) -> [u16; 4] {
         self.qbox[k]

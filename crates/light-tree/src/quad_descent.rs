@@ -1,7 +1,7 @@
-//! The four-wide descent (`quad.rs`) under any weight: the tree's own compact E&K importance
-//! ([`LightTree::sample_from`]) or a caller's ([`LightTree::sample_quads`], e.g. Liu et al.'s
-//! BRDF-oriented importance), with its pmf replay beside it. One code path for both, so a
-//! caller's descent is the E&K one with other numbers in the lanes.
+//! The four-wide descent (`quad.rs`) under a caller's weight ([`LightTree::sample_quads`],
+//! e.g. Liu et al.'s BRDF-oriented importance), with its pmf replay beside it. (The tree's own
+//! E&K descent is eight-wide, `oct_descent.rs`: a caller's weight of four nodes at a time keeps
+//! its per-node memo small.)
 //!
 //! A step weighs four nodes at once: an even-depth node's four grandchildren (a child that is
 //! a leaf stands in its half beside an empty lane). It picks a half ∝ the sum of its two
@@ -48,8 +48,7 @@ impl<F: FnMut(Option<u32>, &[NodeId; 4]) -> [f32; 4]> QuadWeights for F {
     }
 }
 
-/// What a step weighs by, inside the crate: the E&K lanes read the compact pairs and quads
-/// directly; a caller's weight gets node ids.
+/// What a step weighs by (a caller's weight, through node ids).
 pub(crate) trait StepWeights {
     /// The two children of interior odd-depth `node` (pair `pair` of the compact layout).
     fn pair(&mut self, tree: &LightTree, node: NodeId, pair: u32) -> [f32; 2];

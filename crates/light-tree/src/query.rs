@@ -1,7 +1,6 @@
 //! Queries: node importance, stochastic descent and its pmf replay, cuts.
 
 use crate::compact::LEAF_BIT;
-use crate::quad_descent::StepWeights;
 use crate::{LightTree, Node, NodeId};
 use glam::Vec3;
 use std::collections::VecDeque;
@@ -20,6 +19,13 @@ pub const MIN_EMIT_COS: f32 = 1e-3;
 pub trait DescentRandom {
     /// Returns `true` (go left) with probability `p_left`, `0 < p_left ≤ 1`.
     fn go_left(&mut self, p_left: f32) -> bool;
+    /// A uniform 64-bit number for a choice among several children (the eight-wide
+    /// descent's step, `oct_descent.rs`, which uses its top 63 bits).
+    fn draw(&mut self) -> u64;
+    /// After such a choice took the range [lo, lo + `width`) of [0, 2⁶³) (0 < width ≤ 2⁶³),
+    /// where the drawn number's top 63 bits were lo + `offset`: a rescaling source continues
+    /// with ⌊2⁶⁴ · offset / width⌋.
+    fn chose(&mut self, offset: u64, width: u64);
 }
 
 /// 2⁶⁴ · `p` as an integer: 64 uniform bits fall below it with probability `p` (to 2⁻⁶⁴).
@@ -55,6 +61,15 @@ impl DescentRandom for Rescaled {
             false
         }
     }
+    #[inline]
+    fn draw(&mut self) -> u64 {
+        self.0
+    }
+    #[inline]
+    fn chose(&mut self, offset: u64, width: u64) {
+        // The quotient is below 2⁶⁴ since offset < width.
+        self.0 = (((offset as u128) << 64) / width as u128) as u64;
+    }
 }
 
 /// 64 fresh random bits per level (Liu et al.'s improvement), drawn from the wrapped closure.
@@ -69,12 +84,26 @@ impl<F: FnMut() -> u64> DescentRandom for Fresh<F> {
     fn go_left(&mut self, p_left: f32) -> bool {
         (self.0)() < threshold(p_left)
     }
+    #[inline]
+    fn draw(&mut self) -> u64 {
+        (self.0)()
+    }
+    #[inline]
+    fn chose(&mut self, _: u64, _: u64) {}
 }
 
 impl<R: DescentRandom + ?Sized> DescentRandom for &mut R {
     #[inline]
     fn go_left(&mut self, p_left: f32) -> bool {
         (**self).go_left(p_left)
+    }
+    #[inline]
+    fn draw(&mut self) -> u64 {
+        (**self).draw()
+    }
+    #[inline]
+    fn chose(&mut self, offset: u64, width: u64) {
+        (**self).chose(offset, width)
     }
 }
 
@@ -123,51 +152,6 @@ pub(crate) fn choose<R: DescentRandom>(il: f32, ir: f32, rng: &mut R) -> Option<
         rng.go_left(pl)
     };
     Some(if left { (true, pl) } else { (false, ir / sum) })
-}
-
-/// A cache of one receiver's E&K quad lanes for [`LightTree::pmf_from_cached`], keyed by quad
-/// index. The lanes are a pure function of (quad, x, n), so a cached value is the recomputed one.
-pub trait QuadLaneCache {
-    /// The cached lanes of `quad`, or `compute()` kept for next time.
-    fn get_or(&mut self, quad: u32, compute: impl FnOnce() -> [f32; 4]) -> [f32; 4];
-}
-
-/// [`EkLanes`] through a [`QuadLaneCache`] (the odd-depth pair step, at most once per replay,
-/// is not cached).
-struct CachedEkLanes<'c, C> {
-    x: Vec3,
-    n: Vec3,
-    cache: &'c mut C,
-}
-
-impl<C: QuadLaneCache> StepWeights for CachedEkLanes<'_, C> {
-    #[inline(always)]
-    fn pair(&mut self, tree: &LightTree, _: NodeId, pair: u32) -> [f32; 2] {
-        tree.pair_importances(pair, self.x, self.n)
-    }
-    #[inline(always)]
-    fn quad(&mut self, tree: &LightTree, quad: u32) -> [f32; 4] {
-        let (x, n) = (self.x, self.n);
-        self.cache
-            .get_or(quad, || tree.quad_node_importances(quad, x, n))
-    }
-}
-
-/// The four-wide descent's lanes under the tree's compact E&K importance at (x, n).
-struct EkLanes {
-    x: Vec3,
-    n: Vec3,
-}
-
-impl StepWeights for EkLanes {
-    #[inline(always)]
-    fn pair(&mut self, tree: &LightTree, _: NodeId, pair: u32) -> [f32; 2] {
-        tree.pair_importances(pair, self.x, self.n)
-    }
-    #[inline(always)]
-    fn quad(&mut self, tree: &LightTree, quad: u32) -> [f32; 4] {
-        tree.quad_node_importances(quad, self.x, self.n)
-    }
 }
 
 impl Node {
@@ -523,43 +507,6 @@ impl LightTree {
     #[inline]
     pub fn pmf(&self, x: Vec3, n: Vec3, light: usize) -> f32 {
         self.pmf_from(self.root(), x, n, light)
-    }
-
-    /// A descent from `start` under [`LightTree::importance`], two levels per step on the
-    /// four-wide quads (`quad.rs`): one dependent load and one four-lane evaluation per two
-    /// levels. It is the binary descent in which an interior node at odd depth weighs as the
-    /// sum of its two children's importances (sanitised, then summed), every other node as its
-    /// own: bit for bit `sample_subtree(start, that importance, rng)`. An odd-depth `start`
-    /// takes one binary step first.
-    pub fn sample_from<R: DescentRandom>(
-        &self,
-        start: NodeId,
-        x: Vec3,
-        n: Vec3,
-        rng: &mut R,
-    ) -> Option<(usize, f32)> {
-        self.descend(start, &mut EkLanes { x, n }, rng)
-    }
-
-    /// Probability that [`LightTree::sample_from`] from `start` returns `light` (0 if `light`
-    /// is not under `start`), replayed along its bit trail with the same operations.
-    pub fn pmf_from(&self, start: NodeId, x: Vec3, n: Vec3, light: usize) -> f32 {
-        self.replay(start, &mut EkLanes { x, n }, light)
-    }
-
-    /// [`LightTree::pmf_from`] with each quad's lanes taken from `cache` when it has them and
-    /// put there when not: bit for bit the same value. For a caller that replays many pmfs at
-    /// one (x, n) (the method's MIS weights at a glossy point), whose replays share the top of
-    /// the tree; `cache` must hold lanes of this (x, n) only.
-    pub fn pmf_from_cached<C: QuadLaneCache>(
-        &self,
-        start: NodeId,
-        x: Vec3,
-        n: Vec3,
-        light: usize,
-        cache: &mut C,
-    ) -> f32 {
-        self.replay(start, &mut CachedEkLanes { x, n, cache }, light)
     }
 
     /// Generic descent from `start`: at each interior node go left with probability

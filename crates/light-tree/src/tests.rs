@@ -108,14 +108,23 @@ pub(crate) fn rand_receiver(rng: &mut impl Rng) -> (Vec3, Vec3) {
 
 /// Reference distribution of a descent from `start` by top-down propagation:
 /// (probability per light, mass lost in dead ends).
-/// The node weights of the four-wide descent (`LightTree::sample`): `importance`, except that
-/// an interior node at odd depth weighs as the sum of its children's (sanitised).
-pub(crate) fn four_wide_importance(tree: &LightTree, id: NodeId, x: Vec3, n: Vec3) -> f32 {
+/// The node weights of the eight-wide descent from `start` (`LightTree::sample_from`):
+/// `importance`, except that an interior node at a depth not divisible by 3, below the first
+/// such depth under `start` (above it the descent takes binary steps), weighs as the sum of
+/// its children's weights (sanitised).
+pub(crate) fn eight_wide_importance(
+    tree: &LightTree,
+    start: NodeId,
+    id: NodeId,
+    x: Vec3,
+    n: Vec3,
+) -> f32 {
+    let first_oct = tree.node(start).depth().div_ceil(3) * 3;
     let node = tree.node(id);
     match node.children(id) {
-        Some((l, r)) if node.depth() % 2 == 1 => {
-            crate::query::sanitize(tree.importance(l, x, n))
-                + crate::query::sanitize(tree.importance(r, x, n))
+        Some((l, r)) if node.depth() % 3 != 0 && node.depth() > first_oct => {
+            let w = |c| crate::query::sanitize(eight_wide_importance(tree, start, c, x, n));
+            w(l) + w(r)
         }
         _ => tree.importance(id, x, n),
     }
@@ -316,7 +325,7 @@ fn pmf_sums_to_one_and_matches_sample() {
             let tree = LightTree::build(&lights).unwrap();
             for _ in 0..10 {
                 let (x, nrm) = rand_receiver(&mut rng);
-                let imp = |id| four_wide_importance(&tree, id, x, nrm);
+                let imp = |id| eight_wide_importance(&tree, tree.root(), id, x, nrm);
                 let (reference, dead) = reference_pmf(&tree, tree.root(), &imp);
                 let pmfs: Vec<f32> = (0..n).map(|l| tree.pmf(x, nrm, l)).collect();
                 let sum: f64 = pmfs.iter().map(|&p| p as f64).sum();

@@ -1,11 +1,12 @@
 //! A direct-mapped cache of per-node values (importances) of one shading point, or of
-//! per-quad values (the four lanes of a four-wide descent step, keyed by quad index).
+//! per-quad or per-oct values (the lanes of a four- or eight-wide descent step, keyed by quad
+//! or oct index).
 //!
 //! A node's importance is a pure function of (node, shading point), so a cached value is
 //! bit-identical to a recomputed one: sampling and every pdf replay see the same numbers
 //! whether or not a slot was evicted. A slot is valid only under the current stamp, so moving
 //! to the next shading point invalidates the cache without clearing it.
-use light_tree::{NodeId, QuadLaneCache};
+use light_tree::{LaneCache, NodeId};
 
 const SLOTS: usize = 1024;
 
@@ -26,6 +27,9 @@ pub struct Memo<V> {
 pub type NodeMemo = Memo<f32>;
 /// The four lanes of a quad (`light_tree::LightTree::quad_nodes`), keyed by quad index.
 pub type QuadMemo = Memo<[f32; 4]>;
+/// The eight E&K lanes of an oct (`light_tree::LightTree::pmf_from_cached`), keyed by oct
+/// index.
+pub type OctMemo = Memo<[f32; 8]>;
 
 impl<V: Copy + Default> Default for Memo<V> {
     fn default() -> Memo<V> {
@@ -94,9 +98,13 @@ impl<V: Copy> Memo<V> {
 }
 
 /// The E&K lanes of a shading point's LS pmf replays (`TreeState::with_cached_pmf`).
-impl QuadLaneCache for QuadMemo {
+impl LaneCache for OctMemo {
     #[inline]
-    fn get_or(&mut self, quad: u32, compute: impl FnOnce() -> [f32; 4]) -> [f32; 4] {
-        Memo::get_or(self, quad, |_| compute())
+    fn get(&mut self, oct: u32) -> Option<[f32; 8]> {
+        Memo::get(self, oct)
+    }
+    #[inline]
+    fn put(&mut self, oct: u32, lanes: [f32; 8]) {
+        self.insert(oct, lanes);
     }
 }

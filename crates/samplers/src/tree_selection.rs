@@ -1,6 +1,6 @@
 //! Light-tree selection (Conty Estevez & Kulla 2018): a single stochastic descent, or
 //! adaptive splitting into a cut with one light drawn per cluster.
-use crate::memo::QuadMemo;
+use crate::memo::OctMemo;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use light_tree::{Cut, LightBounds, LightTree, NodeId, Rescaled, SplitParams};
@@ -77,13 +77,13 @@ impl TreeSelection {
     }
 }
 
-/// The per-thread buffers of one shading point: the adaptive cut, and the quad lanes its pmf
+/// The per-thread buffers of one shading point: the adaptive cut, and the oct lanes its pmf
 /// replays read when the state caches them ([`TreeState::with_cached_pmf`]).
 #[derive(Default)]
 pub struct TreeScratch {
     cut: Cut,
     queue: VecDeque<NodeId>,
-    lanes: RefCell<QuadMemo>,
+    lanes: RefCell<OctMemo>,
 }
 
 crate::scratch_pool!(TreeScratch, |s| {
@@ -94,8 +94,8 @@ crate::scratch_pool!(TreeScratch, |s| {
 
 /// The E&K cut of one shading point (none for a single descent), in per-thread scratch.
 ///
-/// The picks and pmf replays descend the tree's four-wide quads
-/// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per two levels. No memo
+/// The picks and pmf replays descend the tree's eight-wide octs
+/// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per three levels. No memo
 /// by default: on `builtin:emissive-mesh` only 338 of 9,724 shading points of `tree+bsdf`
 /// replayed a pmf (callgrind, docs/light-tree.md), so its lookups cost more than they saved.
 /// The method replays one per BRDF-aware sample and asks for the memo
@@ -119,7 +119,7 @@ impl TreeState {
         self.split.then_some(&self.scratch.cut)
     }
 
-    /// This state's pmf replays keep the quad lanes they evaluate for the next replay (bit for
+    /// This state's pmf replays keep the oct lanes they evaluate for the next replay (bit for
     /// bit the same pmfs): for a caller that replays many at one shading point.
     pub fn with_cached_pmf(mut self) -> Self {
         self.cached_pmf = true;

@@ -45,6 +45,14 @@ impl<F: FnMut() -> u64> DescentRandom for FreshPerStep<F> {
         self.left -= 1;
         self.u.go_left(p_left)
     }
+    // The BO descent steps by binary decisions only (the quads'); a many-way choice takes a
+    // fresh number of its own.
+    #[inline]
+    fn draw(&mut self) -> u64 {
+        (self.next)()
+    }
+    #[inline]
+    fn chose(&mut self, _: u64, _: u64) {}
 }
 
 /// Per-thread buffers of one shading point's BO state: the cut, its build scratch and the
