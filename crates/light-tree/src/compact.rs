@@ -399,20 +399,12 @@ fn dot3<L: Copy + std::ops::Add<Output = L> + std::ops::Mul<Output = L>>(
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
+/// Integer codes as lanes of f32.
 #[inline(always)]
-fn from_u16<const N: usize, L: Lanes<N>>(c: [u16; N]) -> L {
+fn from_codes<const N: usize, L: Lanes<N>, T: Copy + Into<f32>>(c: [T; N]) -> L {
     let mut f = [0.0f32; N];
     for k in 0..N {
-        f[k] = c[k] as f32;
-    }
-    L::load(f)
-}
-
-#[inline(always)]
-fn from_i16<const N: usize, L: Lanes<N>>(c: [i16; N]) -> L {
-    let mut f = [0.0f32; N];
-    for k in 0..N {
-        f[k] = c[k] as f32;
+        f[k] = c[k].into();
     }
     L::load(f)
 }
@@ -450,8 +442,8 @@ pub(crate) fn slots_evaluated<const N: usize, L: Lanes<N>, S: Slots<N>>(
     let mut h = [L::splat(0.0); 3];
     for k in 0..3 {
         let (o, st) = (L::splat(q.origin[k]), L::splat(q.step[k]));
-        let lo = o + from_u16::<N, L>(s.qbox(k)) * st;
-        let hi = o + from_u16::<N, L>(s.qbox(k + 3)) * st;
+        let lo = o + from_codes::<N, L, _>(s.qbox(k)) * st;
+        let hi = o + from_codes::<N, L, _>(s.qbox(k + 3)) * st;
         c[k] = (lo + hi) * half_l - L::splat(x[k]);
         h[k] = (hi - lo) * half_l;
     }
@@ -459,9 +451,9 @@ pub(crate) fn slots_evaluated<const N: usize, L: Lanes<N>, S: Slots<N>>(
     let one = L::splat(1.0);
 
     let ax = [
-        from_i16::<N, L>(s.axis(0)),
-        from_i16::<N, L>(s.axis(1)),
-        from_i16::<N, L>(s.axis(2)),
+        from_codes::<N, L, _>(s.axis(0)),
+        from_codes::<N, L, _>(s.axis(1)),
+        from_codes::<N, L, _>(s.axis(2)),
     ];
     let flags = s.flags();
     let inv_len = one / dot3(&ax, &ax).sqrt();
@@ -550,7 +542,7 @@ impl LightTree {
     /// [`crate::QuadView`]).
     pub fn quad_view(&self, quad: u32, x: Vec3) -> crate::QuadView {
         let c = &self.compact;
-        let e = slots_evaluated::<4, Fast, _>(&c.quads[quad as usize], &c.quant, x, Vec3::ZERO);
+        let e = slots_evaluated::<4, Fast, _>(&c.quads[quad as usize].0, &c.quant, x, Vec3::ZERO);
         crate::QuadView {
             to_centre: e.to_centre,
             radius_sq: e.radius_sq,

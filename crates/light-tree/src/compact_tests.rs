@@ -143,8 +143,8 @@ fn quads_hold_the_grandchildren() {
                     continue;
                 }
                 let quad = &c.quads[q as usize];
-                let fast = slots_importance::<4, Fast, _>(quad, &c.quant, x, n);
-                let portable = slots_importance::<4, Scalar4, _>(quad, &c.quant, x, n);
+                let fast = slots_importance::<4, Fast, _>(&quad.0, &c.quant, x, n);
+                let portable = slots_importance::<4, Scalar4, _>(&quad.0, &c.quant, x, n);
                 assert_eq!(fast.map(f32::to_bits), portable.map(f32::to_bits));
                 for (half, child) in [(0, l), (1, r)] {
                     let lanes: [Option<NodeId>; 2] = match tree.node(child).children(child) {

@@ -38,11 +38,6 @@ pub(crate) trait Lanes<const N: usize>:
     fn select(mask: Self, a: Self, b: Self) -> Self {
         mask.and(a).or(mask.andnot(b))
     }
-    /// A mask from N flags.
-    #[inline(always)]
-    fn mask(f: [bool; N]) -> Self {
-        Self::load(f.map(|b| f32::from_bits(if b { u32::MAX } else { 0 })))
-    }
 }
 
 /// The portable lanes (and the reference that the SIMD lanes are tested against).

@@ -72,6 +72,7 @@ mod compact;
 #[cfg(test)]
 mod compact_tests;
 mod cone;
+mod lane_slots;
 mod lanes;
 mod oct;
 mod oct_descent;

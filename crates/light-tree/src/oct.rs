@@ -10,70 +10,20 @@
 //! (`oct_descent.rs`): the binary descent in which interior nodes at the two depths between
 //! weigh as the sum of their lanes.
 
-use crate::compact::{LEAF_BIT, Slot, Slots};
+use crate::compact::{LEAF_BIT, Slot};
+use crate::lane_slots::LaneSlots;
 use crate::{NO_NODE, Node, NodeId};
 
-/// Eight slots, structure-of-arrays, lanes in branch-bit order; 256 bytes.
+/// Eight slots in branch-bit order, in four cache lines.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(256))]
-pub(crate) struct OctNode {
-    qbox: [[u16; 8]; 6],
-    axis: [[i16; 8]; 3],
-    cos_o: [i16; 8],
-    cos_e: [i16; 8],
-    power: [f32; 8],
-    /// Interior slot (at a depth divisible by 3): index of its own oct. Leaf: `LEAF_BIT |
-    /// light`. Empty: `LEAF_BIT` with zero power, never chosen.
-    pub(crate) child: [u32; 8],
-    flags: [u8; 8],
-}
+pub(crate) struct OctNode(pub(crate) LaneSlots<8>);
 
-impl OctNode {
-    fn set(&mut self, lane: usize, s: &Slot, child: u32) {
-        for k in 0..6 {
-            self.qbox[k][lane] = s.qbox[k];
-        }
-        for k in 0..3 {
-            self.axis[k][lane] = s.axis[k];
-        }
-        self.cos_o[lane] = s.cos_o;
-        self.cos_e[lane] = s.cos_e;
-        self.power[lane] = s.power;
-        self.flags[lane] = s.flags;
-        self.child[lane] = child;
-    }
-
-    /// A lane of zero power (importance 0; a valid axis keeps NaN out of it).
-    fn set_empty(&mut self, lane: usize) {
-        self.axis[2][lane] = i16::MAX;
-        self.child[lane] = LEAF_BIT;
-    }
-}
-
-impl Slots<8> for OctNode {
+impl std::ops::Deref for OctNode {
+    type Target = LaneSlots<8>;
     #[inline(always)]
-    fn qbox(&self, k: usize) -> [u16; 8] {
-        self.qbox[k]
-    }
-    #[inline(always)]
-    fn axis(&self, k: usize) -> [i16; 8] {
-        self.axis[k]
-    }
-    #[inline(always)]
-    fn cos_o(&self) -> [i16; 8] {
-        self.cos_o
-    }
-    #[inline(always)]
-    fn cos_e(&self) -> [i16; 8] {
-        self.cos_e
-    }
-    #[inline(always)]
-    fn power(&self) -> [f32; 8] {
-        self.power
-    }
-    #[inline(always)]
-    fn flags(&self) -> [u8; 8] {
-        self.flags
+    fn deref(&self) -> &LaneSlots<8> {
+        &self.0
     }
 }
 
@@ -111,10 +61,10 @@ pub(crate) fn build(nodes: &[Node], slots: &[Slot]) -> (Vec<OctNode>, Vec<u32>, 
                     stack.push((b, first + span / 2, span / 2));
                 }
                 _ => {
-                    octs[o as usize].set(first, &slots[n as usize], code(n));
+                    octs[o as usize].0.set(first, &slots[n as usize], code(n));
                     lanes[o as usize][first] = n;
                     for lane in first + 1..first + span {
-                        octs[o as usize].set_empty(lane);
+                        octs[o as usize].0.set_empty(lane);
                     }
                 }
             }

@@ -76,7 +76,7 @@ impl<L: Lanes<8>> OctLanes for Ek<L> {
     #[inline(always)]
     fn lanes(&mut self, tree: &LightTree, oct: u32) -> [f32; 8] {
         let c = &tree.compact;
-        slots_importance::<8, L, _>(&c.octs[oct as usize], &c.quant, self.x, self.n)
+        slots_importance::<8, L, _>(&c.octs[oct as usize].0, &c.quant, self.x, self.n)
     }
 }
 

@@ -9,70 +9,20 @@
 //! by its own importance: the binary descent in which an odd-depth interior node weighs as
 //! the sum of its children's importances (see `compact_tests.rs`).
 
-use crate::compact::{LEAF_BIT, Slot, Slots};
+use crate::compact::{LEAF_BIT, Slot};
+use crate::lane_slots::LaneSlots;
 use crate::{NO_NODE, Node, NodeId};
 
-/// Four slots, structure-of-arrays, lanes `[left.l, left.r, right.l, right.r]`; 128 bytes.
+/// Four slots, lanes `[left.l, left.r, right.l, right.r]`, in two cache lines.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(128))]
-pub(crate) struct QuadNode {
-    qbox: [[u16; 4]; 6],
-    axis: [[i16; 4]; 3],
-    cos_o: [i16; 4],
-    cos_e: [i16; 4],
-    power: [f32; 4],
-    /// Interior (even-depth) slot: index of its own quad. Leaf: `LEAF_BIT | light`. Empty:
-    /// `LEAF_BIT` with zero power, never chosen.
-    pub(crate) child: [u32; 4],
-    flags: [u8; 4],
-}
+pub(crate) struct QuadNode(pub(crate) LaneSlots<4>);
 
-impl QuadNode {
-    fn set(&mut self, lane: usize, s: &Slot, child: u32) {
-        for k in 0..6 {
-            self.qbox[k][lane] = s.qbox[k];
-        }
-        for k in 0..3 {
-            self.axis[k][lane] = s.axis[k];
-        }
-        self.cos_o[lane] = s.cos_o;
-        self.cos_e[lane] = s.cos_e;
-        self.power[lane] = s.power;
-        self.flags[lane] = s.flags;
-        self.child[lane] = child;
-    }
-
-    /// A lane of zero power (importance 0; a valid axis keeps NaN out of it).
-    fn set_empty(&mut self, lane: usize) {
-        self.axis[2][lane] = i16::MAX;
-        self.child[lane] = LEAF_BIT;
-    }
-}
-
-impl Slots<4> for QuadNode {
+impl std::ops::Deref for QuadNode {
+    type Target = LaneSlots<4>;
     #[inline(always)]
-    fn qbox(&self, k: usize) -> [u16; 4] {
-        self.qbox[k]
-    }
-    #[inline(always)]
-    fn axis(&self, k: usize) -> [i16; 4] {
-        self.axis[k]
-    }
-    #[inline(always)]
-    fn cos_o(&self) -> [i16; 4] {
-        self.cos_o
-    }
-    #[inline(always)]
-    fn cos_e(&self) -> [i16; 4] {
-        self.cos_e
-    }
-    #[inline(always)]
-    fn power(&self) -> [f32; 4] {
-        self.power
-    }
-    #[inline(always)]
-    fn flags(&self) -> [u8; 4] {
-        self.flags
+    fn deref(&self) -> &LaneSlots<4> {
+        &self.0
     }
 }
 
@@ -105,14 +55,14 @@ pub(crate) fn build(nodes: &[Node], slots: &[Slot]) -> (Vec<QuadNode>, Vec<u32>,
         for (half, c) in [(0, l), (1, r)] {
             match nodes[c as usize].children(c) {
                 Some((cl, cr)) => {
-                    quad.set(2 * half, &slots[cl as usize], code(cl));
-                    quad.set(2 * half + 1, &slots[cr as usize], code(cr));
+                    quad.0.set(2 * half, &slots[cl as usize], code(cl));
+                    quad.0.set(2 * half + 1, &slots[cr as usize], code(cr));
                     lanes[q as usize][2 * half] = cl;
                     lanes[q as usize][2 * half + 1] = cr;
                 }
                 None => {
-                    quad.set(2 * half, &slots[c as usize], code(c));
-                    quad.set_empty(2 * half + 1);
+                    quad.0.set(2 * half, &slots[c as usize], code(c));
+                    quad.0.set_empty(2 * half + 1);
                     lanes[q as usize][2 * half] = c;
                 }
             }
