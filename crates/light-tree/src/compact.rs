@@ -230,8 +230,8 @@ pub(crate) struct Compact {
     pub(crate) octs: Vec<OctNode>,
     /// Per node: its oct, `u32::MAX` for leaves and depths not divisible by 3.
     pub(crate) oct_of: Vec<u32>,
-    /// Per oct: the nodes in its lanes (`NO_NODE` for an empty one; the tests read it).
-    #[cfg_attr(not(test), allow(dead_code))]
+    /// Per oct: the nodes in its lanes (`NO_NODE` for an empty one); kept for the tests only.
+    #[cfg(test)]
     pub(crate) oct_nodes: Vec<[crate::NodeId; 8]>,
     /// The lanes the E&K descent evaluates on.
     pub(crate) simd: DescentSimd,
@@ -277,6 +277,7 @@ impl Compact {
             }
         }
         let (quads, quad_of, quad_nodes) = crate::quad::build(nodes, &slots);
+        #[cfg_attr(not(test), allow(unused_variables))]
         let (octs, oct_of, oct_nodes) = crate::oct::build(nodes, &slots);
         Ok(Compact {
             quant,
@@ -288,6 +289,7 @@ impl Compact {
             quad_nodes,
             octs,
             oct_of,
+            #[cfg(test)]
             oct_nodes,
             simd: DescentSimd::detect(),
         })

@@ -22,7 +22,7 @@
 
 use crate::compact::{LEAF_BIT, slots_importance};
 use crate::lanes::{Fast8, Lanes};
-use crate::query::{DescentRandom, choose, sanitize};
+use crate::query::{DescentRandom, choose, chosen, sanitize};
 use crate::{LightTree, NodeId};
 use glam::Vec3;
 use std::marker::PhantomData;
@@ -270,13 +270,11 @@ impl LightTree {
                 return 0.0;
             };
             let [il, ir] = self.pair_importances(pair, x, n);
-            let (il, ir) = (sanitize(il), sanitize(ir));
-            let sum = il + ir;
-            if sum == 0.0 {
-                return 0.0;
-            }
             let right = bits & 1 == 1;
-            pmf *= if right { ir / sum } else { il / sum };
+            let Some(f) = chosen(sanitize(il), sanitize(ir), right) else {
+                return 0.0;
+            };
+            pmf *= f;
             id = if right {
                 self.nodes[id as usize].child_or_light
             } else {

@@ -10,7 +10,7 @@
 //! step between its two children first.
 
 use crate::compact::LEAF_BIT;
-use crate::query::{DescentRandom, choose, sanitize};
+use crate::query::{DescentRandom, choose, chosen, sanitize};
 use crate::{LightTree, NodeId};
 
 /// A lane that holds no node (the second lane of a leaf's half, the pair step's lanes 2, 3).
@@ -48,24 +48,19 @@ impl<F: FnMut(Option<u32>, &[NodeId; 4]) -> [f32; 4]> QuadWeights for F {
     }
 }
 
-/// What a step weighs by (a caller's weight, through node ids).
-pub(crate) trait StepWeights {
-    /// The two children of interior odd-depth `node` (pair `pair` of the compact layout).
-    fn pair(&mut self, tree: &LightTree, node: NodeId, pair: u32) -> [f32; 2];
-    /// The four lanes of quad `quad`.
-    fn quad(&mut self, tree: &LightTree, quad: u32) -> [f32; 4];
-}
-
-/// A caller's [`QuadWeights`] as [`StepWeights`]: empty lanes weigh 0.
+/// A caller's [`QuadWeights`] as the descent reads it: a step's lanes by node id, empty lanes
+/// weighing 0.
 struct ByNode<'w, W: QuadWeights>(&'w mut W);
 
-impl<W: QuadWeights> StepWeights for ByNode<'_, W> {
+impl<W: QuadWeights> ByNode<'_, W> {
+    /// The two children of interior odd-depth `node`.
     #[inline(always)]
-    fn pair(&mut self, tree: &LightTree, node: NodeId, _: u32) -> [f32; 2] {
+    fn pair(&mut self, tree: &LightTree, node: NodeId) -> [f32; 2] {
         let right = tree.nodes[node as usize].child_or_light;
         let w = self.0.weigh(None, &[node + 1, right, NO_NODE, NO_NODE]);
         [w[0], w[1]]
     }
+    /// The four lanes of quad `quad`.
     #[inline(always)]
     fn quad(&mut self, tree: &LightTree, quad: u32) -> [f32; 4] {
         let nodes = &tree.compact.quad_nodes[quad as usize];
@@ -106,12 +101,12 @@ impl LightTree {
         self.replay(start, &mut ByNode(weights), light)
     }
 
-    /// The descent of [`LightTree::sample_quads`] under any [`StepWeights`].
+    /// The descent of [`LightTree::sample_quads`].
     #[inline(always)]
-    pub(crate) fn descend<W: StepWeights, R: DescentRandom>(
+    fn descend<W: QuadWeights, R: DescentRandom>(
         &self,
         start: NodeId,
-        weights: &mut W,
+        weights: &mut ByNode<W>,
         rng: &mut R,
     ) -> Option<(usize, f32)> {
         let node = &self.nodes[start as usize];
@@ -122,8 +117,7 @@ impl LightTree {
         let mut quad = if node.depth() % 2 == 0 {
             self.compact.quad_of[start as usize]
         } else {
-            let pair = self.children_pair(start)?;
-            let [il, ir] = weights.pair(self, start, pair).map(sanitize);
+            let [il, ir] = weights.pair(self, start).map(sanitize);
             let (left, f) = choose(il, ir, rng)?;
             pmf *= f;
             let child = if left { start + 1 } else { node.child_or_light };
@@ -158,12 +152,7 @@ impl LightTree {
 
     /// The pmf replay of [`LightTree::descend`] along `light`'s bit trail.
     #[inline(always)]
-    pub(crate) fn replay<W: StepWeights>(
-        &self,
-        start: NodeId,
-        weights: &mut W,
-        light: usize,
-    ) -> f32 {
+    fn replay<W: QuadWeights>(&self, start: NodeId, weights: &mut ByNode<W>, light: usize) -> f32 {
         let leaf = self.leaf_of[light];
         let (first, last) = self.subtree_range(start);
         if leaf < first || leaf > last {
@@ -177,20 +166,12 @@ impl LightTree {
         let mut depth = node.depth();
         // `start` is interior here, so its depth is below 64.
         let mut bits = self.trails[light] >> depth;
-        let step = |il: f32, ir: f32, side: u64| {
-            let (il, ir) = (sanitize(il), sanitize(ir));
-            let sum = il + ir;
-            (sum != 0.0).then(|| if side == 0 { il / sum } else { ir / sum })
-        };
         let mut pmf = 1.0f32;
         let mut quad = if depth % 2 == 0 {
             self.compact.quad_of[start as usize]
         } else {
-            let Some(pair) = self.children_pair(start) else {
-                return 0.0;
-            };
-            let [il, ir] = weights.pair(self, start, pair);
-            let Some(f) = step(il, ir, bits & 1) else {
+            let [il, ir] = weights.pair(self, start).map(sanitize);
+            let Some(f) = chosen(il, ir, bits & 1 == 1) else {
                 return 0.0;
             };
             pmf *= f;
@@ -211,7 +192,7 @@ impl LightTree {
             let q = &quads[quad as usize];
             let g = weights.quad(self, quad).map(sanitize);
             let (ia, ib) = (sanitize(g[0] + g[1]), sanitize(g[2] + g[3]));
-            let Some(f) = step(ia, ib, bits & 1) else {
+            let Some(f) = chosen(ia, ib, bits & 1 == 1) else {
                 return 0.0;
             };
             pmf *= f;
@@ -222,7 +203,7 @@ impl LightTree {
             } else {
                 (bits >> 1) & 1
             };
-            let Some(f) = step(g[h], g[h + 1], lane) else {
+            let Some(f) = chosen(g[h], g[h + 1], lane == 1) else {
                 return 0.0;
             };
             pmf *= f;

@@ -154,6 +154,15 @@ pub(crate) fn choose<R: DescentRandom>(il: f32, ir: f32, rng: &mut R) -> Option<
     Some(if left { (true, pl) } else { (false, ir / sum) })
 }
 
+/// The probability with which [`choose`] takes the right (`right`) or left child between
+/// sanitised importances `il`, `ir`, by the same quotients; `None` when both are 0. What the
+/// pmf replays multiply in.
+#[inline(always)]
+pub(crate) fn chosen(il: f32, ir: f32, right: bool) -> Option<f32> {
+    let sum = il + ir;
+    (sum != 0.0).then(|| if right { ir / sum } else { il / sum })
+}
+
 impl Node {
     /// E&K importance of this node for a receiver at `x` with normal `n`; see
     /// [`LightTree::importance`].
