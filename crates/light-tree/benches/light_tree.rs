@@ -7,7 +7,7 @@
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use light_tree::{LightBounds, LightTree, SplitCriterion, SplitParams};
+use light_tree::{LightBounds, LightTree, Rescaled, SplitCriterion, SplitParams};
 
 /// The authors' cut: τ = 0.85, their σ, at most 64 nodes (the figures in the README).
 const SPLIT: SplitParams = SplitParams {
@@ -122,6 +122,43 @@ fn bench_queries(c: &mut Criterion) {
         });
     }
     g.finish();
+    // The same descents (without the replays), one at a time and two side by side.
+    for paired in [false, true] {
+        let mut g = c.benchmark_group(if paired { "sample, paired" } else { "sample, single" });
+        g.sample_size(20)
+            .warm_up_time(Duration::from_millis(500))
+            .measurement_time(Duration::from_secs(2));
+        g.throughput(Throughput::Elements(QUERIES as u64));
+        for (n, tree) in &trees {
+            g.bench_with_input(BenchmarkId::from_parameter(n), tree, |b, tree| {
+                b.iter(|| {
+                    let mut acc = 0.0f32;
+                    let root = tree.root();
+                    for q in qs.chunks_exact(2) {
+                        let (mut ua, mut ub) = (Rescaled(q[0].2), Rescaled(q[1].2));
+                        let found = if paired {
+                            tree.sample_pair_from(
+                                [root, root],
+                                [q[0].0, q[1].0],
+                                [q[0].1, q[1].1],
+                                [&mut ua, &mut ub],
+                            )
+                        } else {
+                            [
+                                tree.sample_from(root, q[0].0, q[0].1, &mut ua),
+                                tree.sample_from(root, q[1].0, q[1].1, &mut ub),
+                            ]
+                        };
+                        for (_, p) in found.into_iter().flatten() {
+                            acc += p;
+                        }
+                    }
+                    acc
+                })
+            });
+        }
+        g.finish();
+    }
     let mut g = c.benchmark_group("adaptive_cut(0.85,64)");
     g.sample_size(20)
         .warm_up_time(Duration::from_millis(500))

@@ -439,6 +439,62 @@ pub(crate) fn slots_evaluated<const N: usize, L: Lanes<N>, S: Slots<N>>(
     x: Vec3,
     n: Vec3,
 ) -> SlotsEvaluated<N> {
+    slots_evaluated_for::<N, L, S>(s, q, &receiver::<N, L>(x, n))
+}
+
+/// A receiver per lane: its position, its normal (zero: none, then for every lane) and the
+/// normal's absolute components.
+pub(crate) struct LaneReceiver<L> {
+    pub(crate) x: [L; 3],
+    pub(crate) n: [L; 3],
+    pub(crate) n_abs: [L; 3],
+    pub(crate) has_n: bool,
+}
+
+/// One receiver (x, n) in every lane.
+#[inline(always)]
+pub(crate) fn receiver<const N: usize, L: Lanes<N>>(x: Vec3, n: Vec3) -> LaneReceiver<L> {
+    LaneReceiver {
+        x: [L::splat(x.x), L::splat(x.y), L::splat(x.z)],
+        n: [L::splat(n.x), L::splat(n.y), L::splat(n.z)],
+        n_abs: [L::splat(n.x.abs()), L::splat(n.y.abs()), L::splat(n.z.abs())],
+        has_n: n != Vec3::ZERO,
+    }
+}
+
+/// Receiver `a` in lanes 0–7 and `b` in lanes 8–15 (two descents side by side); both must
+/// have a normal or both none.
+#[inline(always)]
+pub(crate) fn receiver_pair<L: Lanes<16>>(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> LaneReceiver<L> {
+    debug_assert_eq!(a.1 == Vec3::ZERO, b.1 == Vec3::ZERO);
+    let (xa, na, xb, nb) = (a.0, a.1, b.0, b.1);
+    LaneReceiver {
+        x: [halves(xa.x, xb.x), halves(xa.y, xb.y), halves(xa.z, xb.z)],
+        n: [halves(na.x, nb.x), halves(na.y, nb.y), halves(na.z, nb.z)],
+        n_abs: [
+            halves(na.x.abs(), nb.x.abs()),
+            halves(na.y.abs(), nb.y.abs()),
+            halves(na.z.abs(), nb.z.abs()),
+        ],
+        has_n: a.1 != Vec3::ZERO,
+    }
+}
+
+/// `a` in lanes 0–7, `b` in lanes 8–15.
+#[inline(always)]
+fn halves<L: Lanes<16>>(a: f32, b: f32) -> L {
+    let mut v = [a; 16];
+    v[8..].fill(b);
+    L::load(v)
+}
+
+/// [`slots_evaluated`] for a receiver per lane.
+#[inline(always)]
+pub(crate) fn slots_evaluated_for<const N: usize, L: Lanes<N>, S: Slots<N>>(
+    s: &S,
+    q: &Quant,
+    r: &LaneReceiver<L>,
+) -> SlotsEvaluated<N> {
     let half_l = L::splat(0.5);
     let mut c = [L::splat(0.0); 3];
     let mut h = [L::splat(0.0); 3];
@@ -446,7 +502,7 @@ pub(crate) fn slots_evaluated<const N: usize, L: Lanes<N>, S: Slots<N>>(
         let (o, st) = (L::splat(q.origin[k]), L::splat(q.step[k]));
         let lo = o + from_codes::<N, L, _>(s.qbox(k)) * st;
         let hi = o + from_codes::<N, L, _>(s.qbox(k + 3)) * st;
-        c[k] = (lo + hi) * half_l - L::splat(x[k]);
+        c[k] = (lo + hi) * half_l - r.x[k];
         h[k] = (hi - lo) * half_l;
     }
     let zero = L::splat(0.0);
@@ -461,17 +517,12 @@ pub(crate) fn slots_evaluated<const N: usize, L: Lanes<N>, S: Slots<N>>(
     let inv_len = one / dot3(&ax, &ax).sqrt();
     let ax = [ax[0] * inv_len, ax[1] * inv_len, ax[2] * inv_len];
 
-    let has_n = n != Vec3::ZERO;
-    let nv = [L::splat(n.x), L::splat(n.y), L::splat(n.z)];
+    let has_n = r.has_n;
+    let nv = r.n;
     // Box tests: wholly behind the tangent plane; behind the box of a half-space emitter.
     let mut dark = zero;
     if has_n {
-        let na = [
-            L::splat(n.x.abs()),
-            L::splat(n.y.abs()),
-            L::splat(n.z.abs()),
-        ];
-        dark = (dot3(&nv, &c) + dot3(&na, &h)).le(zero);
+        dark = (dot3(&nv, &c) + dot3(&r.n_abs, &h)).le(zero);
     }
     let half_space = flag_mask::<N, L>(&flags, FLAG_HALF_SPACE);
     let to_x = [zero - c[0], zero - c[1], zero - c[2]];

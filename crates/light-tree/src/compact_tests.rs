@@ -312,6 +312,46 @@ fn compact_descent_samples_the_eight_wide_weights() {
     }
 }
 
+/// Two descents side by side are the two single descents bit for bit (lights, pmfs, and the
+/// rescaled numbers they leave), on AVX and on the forced fallback, from random start nodes
+/// at any depth (binary steps first), with receivers with and without a normal (mixed pairs
+/// go one after the other).
+#[test]
+fn paired_descents_equal_the_single_ones() {
+    let mut rng = Pcg32::seed_from_u64(45);
+    for (tree, _) in trees(&mut rng) {
+        let mut fallback = tree.clone();
+        fallback.set_descent_simd(DescentSimd::Fallback).unwrap();
+        for t in [&tree, &fallback] {
+            for _ in 0..200 {
+                let q = [rand_receiver(&mut rng), rand_receiver(&mut rng)];
+                let nodes = t.nodes().len() as NodeId;
+                let start = if rng.random::<f32>() < 0.5 {
+                    [t.root(), t.root()]
+                } else {
+                    [rng.random_range(0..nodes), rng.random_range(0..nodes)]
+                };
+                let u = [rng.random::<u64>(), rng.random::<u64>()];
+                let (mut a, mut b) = (Rescaled(u[0]), Rescaled(u[1]));
+                let single = [
+                    t.sample_from(start[0], q[0].0, q[0].1, &mut a),
+                    t.sample_from(start[1], q[1].0, q[1].1, &mut b),
+                ];
+                let (mut pa, mut pb) = (Rescaled(u[0]), Rescaled(u[1]));
+                let paired = t.sample_pair_from(
+                    start,
+                    [q[0].0, q[1].0],
+                    [q[0].1, q[1].1],
+                    [&mut pa, &mut pb],
+                );
+                let bits = |r: [Option<(usize, f32)>; 2]| r.map(|o| o.map(|(l, p)| (l, p.to_bits())));
+                assert_eq!(bits(paired), bits(single));
+                assert_eq!((pa.0, pb.0), (a.0, b.0));
+            }
+        }
+    }
+}
+
 /// `pmf_from_cached` is `pmf_from` bit for bit, whether its cache starts empty, holds every
 /// oct it reads, or forgets some between replays (a direct-mapped cache evicts).
 #[test]

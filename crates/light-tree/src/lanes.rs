@@ -131,13 +131,14 @@ impl<const N: usize> Lanes<N> for Portable<N> {
     }
 }
 
-/// Eight lanes as two four-lane halves (the fallback where AVX is missing).
+/// Lanes as two halves: eight as two fours (the fallback where AVX is missing), or sixteen as
+/// two eights (two descents side by side, `oct_descent.rs`).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Pair<L>(L, L);
 
 macro_rules! pair_op {
     ($tr:ident, $f:ident) => {
-        impl<L: Lanes<4>> $tr for Pair<L> {
+        impl<L: $tr<Output = L>> $tr for Pair<L> {
             type Output = Pair<L>;
             #[inline(always)]
             fn $f(self, o: Pair<L>) -> Pair<L> {
@@ -203,6 +204,64 @@ impl<L: Lanes<4>> Lanes<8> for Pair<L> {
     fn out(self) -> [f32; 8] {
         let (a, b) = (self.0.out(), self.1.out());
         [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]]
+    }
+}
+
+impl<L: Lanes<8>> Lanes<16> for Pair<L> {
+    #[inline(always)]
+    fn load(v: [f32; 16]) -> Self {
+        let mut a = [0.0f32; 8];
+        let mut b = [0.0f32; 8];
+        a.copy_from_slice(&v[..8]);
+        b.copy_from_slice(&v[8..]);
+        Pair(L::load(a), L::load(b))
+    }
+    #[inline(always)]
+    fn splat(v: f32) -> Self {
+        Pair(L::splat(v), L::splat(v))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Pair(self.0.sqrt(), self.1.sqrt())
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        Pair(self.0.min(o.0), self.1.min(o.1))
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        Pair(self.0.max(o.0), self.1.max(o.1))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Pair(self.0.abs(), self.1.abs())
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> Self {
+        Pair(self.0.le(o.0), self.1.le(o.1))
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> Self {
+        Pair(self.0.ge(o.0), self.1.ge(o.1))
+    }
+    #[inline(always)]
+    fn and(self, o: Self) -> Self {
+        Pair(self.0.and(o.0), self.1.and(o.1))
+    }
+    #[inline(always)]
+    fn or(self, o: Self) -> Self {
+        Pair(self.0.or(o.0), self.1.or(o.1))
+    }
+    #[inline(always)]
+    fn andnot(self, o: Self) -> Self {
+        Pair(self.0.andnot(o.0), self.1.andnot(o.1))
+    }
+    #[inline(always)]
+    fn out(self) -> [f32; 16] {
+        let mut v = [0.0f32; 16];
+        v[..8].copy_from_slice(&self.0.out());
+        v[8..].copy_from_slice(&self.1.out());
+        v
     }
 }
 

@@ -10,7 +10,7 @@
 //! (`oct_descent.rs`): the binary descent in which interior nodes at the two depths between
 //! weigh as the sum of their lanes.
 
-use crate::compact::{LEAF_BIT, Slot};
+use crate::compact::{LEAF_BIT, Slot, Slots};
 use crate::lane_slots::LaneSlots;
 use crate::{NO_NODE, Node, NodeId};
 
@@ -71,4 +71,43 @@ pub(crate) fn build(nodes: &[Node], slots: &[Slot]) -> (Vec<OctNode>, Vec<u32>, 
         }
     }
     (octs, oct_of, lanes)
+}
+
+/// Two octs as sixteen slots, `a`'s eight lanes then `b`'s: two descents evaluated side by
+/// side in one pass (`LightTree::sample_pair_from`).
+pub(crate) struct TwoOcts<'a>(pub(crate) &'a OctNode, pub(crate) &'a OctNode);
+
+#[inline(always)]
+fn join<T: Copy + Default>(a: [T; 8], b: [T; 8]) -> [T; 16] {
+    let mut v = [T::default(); 16];
+    v[..8].copy_from_slice(&a);
+    v[8..].copy_from_slice(&b);
+    v
+}
+
+impl Slots<16> for TwoOcts<'_> {
+    #[inline(always)]
+    fn qbox(&self, k: usize) -> [u16; 16] {
+        join(self.0.qbox(k), self.1.qbox(k))
+    }
+    #[inline(always)]
+    fn axis(&self, k: usize) -> [i16; 16] {
+        join(self.0.axis(k), self.1.axis(k))
+    }
+    #[inline(always)]
+    fn cos_o(&self) -> [i16; 16] {
+        join(self.0.cos_o(), self.1.cos_o())
+    }
+    #[inline(always)]
+    fn cos_e(&self) -> [i16; 16] {
+        join(self.0.cos_e(), self.1.cos_e())
+    }
+    #[inline(always)]
+    fn power(&self) -> [f32; 16] {
+        join(self.0.power(), self.1.power())
+    }
+    #[inline(always)]
+    fn flags(&self) -> [u8; 16] {
+        join(self.0.flags(), self.1.flags())
+    }
 }

@@ -20,7 +20,8 @@
 //!
 //! [`Rescaled`]: crate::Rescaled
 
-use crate::compact::{LEAF_BIT, slots_importance};
+use crate::compact::{LEAF_BIT, receiver_pair, slots_evaluated_for, slots_importance};
+use crate::oct::TwoOcts;
 use crate::lanes::{Fast8, Lanes};
 use crate::query::{DescentRandom, choose, chosen, sanitize};
 use crate::{LightTree, NodeId};
@@ -200,45 +201,157 @@ fn share(g: &[f32; 8], lane: usize) -> f32 {
     fraction(hi - lo)
 }
 
+/// Where a descent stands after its binary steps.
+#[derive(Clone, Copy)]
+enum Entry {
+    /// It ended (at a leaf, or at a dead end).
+    Done(Option<(usize, f32)>),
+    /// It goes on from this oct, with this pmf so far.
+    Oct(u32, f32),
+}
+
+/// What one oct step leads to.
+enum Step {
+    Next(u32),
+    Done(Option<(usize, f32)>),
+}
+
 impl LightTree {
     /// The descent of [`LightTree::sample_from`] on lanes `W`.
     #[inline(always)]
     fn oct_descend<W: OctLanes, R: DescentRandom>(
         &self,
         start: NodeId,
-        (x, n): (Vec3, Vec3),
+        xn: (Vec3, Vec3),
         weights: &mut W,
         rng: &mut R,
     ) -> Option<(usize, f32)> {
+        match self.oct_entry(start, xn, rng) {
+            Entry::Done(found) => found,
+            Entry::Oct(oct, pmf) => self.oct_steps(oct, pmf, weights, rng),
+        }
+    }
+
+    /// A descent's binary steps from `start` down to a depth divisible by 3 (none from such a
+    /// depth): where it enters the octs, or its end.
+    #[inline(always)]
+    fn oct_entry<R: DescentRandom>(&self, start: NodeId, (x, n): (Vec3, Vec3), rng: &mut R) -> Entry {
         let mut id = start;
         let mut pmf = 1.0f32;
         while !self.nodes[id as usize].depth().is_multiple_of(3) {
             let node = &self.nodes[id as usize];
             let Some(pair) = self.children_pair(id) else {
-                return Some((node.child_or_light as usize, pmf));
+                return Entry::Done(Some((node.child_or_light as usize, pmf)));
             };
             let [il, ir] = self.pair_importances(pair, x, n);
             let (il, ir) = (sanitize(il), sanitize(ir));
-            let (left, f) = choose(il, ir, rng)?;
+            let Some((left, f)) = choose(il, ir, rng) else {
+                return Entry::Done(None);
+            };
             pmf *= f;
             id = if left { id + 1 } else { node.child_or_light };
         }
         let node = &self.nodes[id as usize];
         if node.is_leaf() {
-            return Some((node.child_or_light as usize, pmf));
+            return Entry::Done(Some((node.child_or_light as usize, pmf)));
         }
-        let octs = &self.compact.octs;
-        let mut oct = self.compact.oct_of[id as usize];
+        Entry::Oct(self.compact.oct_of[id as usize], pmf)
+    }
+
+    /// The oct steps of a descent from `oct`, with `pmf` so far.
+    #[inline(always)]
+    fn oct_steps<W: OctLanes, R: DescentRandom>(
+        &self,
+        mut oct: u32,
+        mut pmf: f32,
+        weights: &mut W,
+        rng: &mut R,
+    ) -> Option<(usize, f32)> {
         loop {
-            let o = &octs[oct as usize];
             let g = sanitized(weights.lanes(self, oct));
-            let (lane, f) = pick(&g, rng)?;
-            pmf *= f;
-            let code = o.child[lane];
-            if code & LEAF_BIT != 0 {
-                return Some(((code & !LEAF_BIT) as usize, pmf));
+            match self.oct_step(oct, &g, &mut pmf, rng) {
+                Step::Next(next) => oct = next,
+                Step::Done(found) => return found,
             }
-            oct = code;
+        }
+    }
+
+    /// One step from `oct`, whose sanitised lanes are `g`: the next oct, or the end.
+    #[inline(always)]
+    fn oct_step<R: DescentRandom>(&self, oct: u32, g: &[f32; 8], pmf: &mut f32, rng: &mut R) -> Step {
+        let Some((lane, f)) = pick(g, rng) else {
+            return Step::Done(None);
+        };
+        *pmf *= f;
+        let code = self.compact.octs[oct as usize].child[lane];
+        if code & LEAF_BIT != 0 {
+            return Step::Done(Some(((code & !LEAF_BIT) as usize, *pmf)));
+        }
+        Step::Next(code)
+    }
+
+    /// Two descents side by side ([`LightTree::sample_pair_from`]): while both are in the
+    /// octs, one sixteen-lane pass on `L16` evaluates both steps, so their dependency chains
+    /// overlap; a descent left alone finishes on `L8`. Each descent draws from its own source
+    /// in its own order, so each is [`LightTree::oct_descend`]'s, bit for bit.
+    #[inline(always)]
+    fn oct_descend_pair<L16: Lanes<16>, L8: Lanes<8>, R: DescentRandom>(
+        &self,
+        start: [NodeId; 2],
+        xn: [(Vec3, Vec3); 2],
+        [ra, rb]: [&mut R; 2],
+    ) -> [Option<(usize, f32)>; 2] {
+        let ea = self.oct_entry(start[0], xn[0], ra);
+        let eb = self.oct_entry(start[1], xn[1], rb);
+        let same_kind = (xn[0].1 == Vec3::ZERO) == (xn[1].1 == Vec3::ZERO);
+        let (Entry::Oct(mut a, mut pa), Entry::Oct(mut b, mut pb), true) = (ea, eb, same_kind)
+        else {
+            return [
+                self.oct_finish::<L8, R>(ea, xn[0], ra),
+                self.oct_finish::<L8, R>(eb, xn[1], rb),
+            ];
+        };
+        let receivers = receiver_pair::<L16>(xn[0], xn[1]);
+        let c = &self.compact;
+        loop {
+            let both = TwoOcts(&c.octs[a as usize], &c.octs[b as usize]);
+            let g = slots_evaluated_for::<16, L16, _>(&both, &c.quant, &receivers).importance;
+            let (mut ga, mut gb) = ([0.0f32; 8], [0.0f32; 8]);
+            ga.copy_from_slice(&g[..8]);
+            gb.copy_from_slice(&g[8..]);
+            let sa = self.oct_step(a, &sanitized(ga), &mut pa, ra);
+            let sb = self.oct_step(b, &sanitized(gb), &mut pb, rb);
+            match (sa, sb) {
+                (Step::Next(na), Step::Next(nb)) => (a, b) = (na, nb),
+                (Step::Next(na), Step::Done(fb)) => {
+                    return [self.oct_finish::<L8, R>(Entry::Oct(na, pa), xn[0], ra), fb];
+                }
+                (Step::Done(fa), Step::Next(nb)) => {
+                    return [fa, self.oct_finish::<L8, R>(Entry::Oct(nb, pb), xn[1], rb)];
+                }
+                (Step::Done(fa), Step::Done(fb)) => return [fa, fb],
+            }
+        }
+    }
+
+    /// The rest of one descent from `entry`, on lanes `L8`.
+    #[inline(always)]
+    fn oct_finish<L8: Lanes<8>, R: DescentRandom>(
+        &self,
+        entry: Entry,
+        (x, n): (Vec3, Vec3),
+        rng: &mut R,
+    ) -> Option<(usize, f32)> {
+        match entry {
+            Entry::Done(found) => found,
+            Entry::Oct(oct, pmf) => {
+                let mut ek = Ek::<L8> {
+                    x,
+                    n,
+                    lanes: PhantomData,
+                };
+                self.oct_steps(oct, pmf, &mut ek, rng)
+            }
         }
     }
 
@@ -369,6 +482,38 @@ impl LightTree {
             lanes: PhantomData,
         };
         self.oct_descend(start, (x, n), &mut ek, rng)
+    }
+
+    /// Two independent descents at once, `[sample_from(start[0], x[0], n[0], rng[0]),
+    /// sample_from(start[1], …)]` bit for bit: while both are in the octs their steps are
+    /// evaluated in one sixteen-lane pass, so that their dependency chains overlap (a caller
+    /// with two shading points' picks at hand, or two clusters of a cut).
+    pub fn sample_pair_from<R: DescentRandom>(
+        &self,
+        start: [NodeId; 2],
+        x: [Vec3; 2],
+        n: [Vec3; 2],
+        rng: [&mut R; 2],
+    ) -> [Option<(usize, f32)>; 2] {
+        let xn = [(x[0], n[0]), (x[1], n[1])];
+        #[cfg(target_arch = "x86_64")]
+        if self.compact.simd == DescentSimd::Avx2 {
+            // SAFETY: as in `sample_from`.
+            return unsafe { self.sample_pair_from_avx2(start, xn, rng) };
+        }
+        self.oct_descend_pair::<crate::lanes::Pair<Fast8>, Fast8, R>(start, xn, rng)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn sample_pair_from_avx2<R: DescentRandom>(
+        &self,
+        start: [NodeId; 2],
+        xn: [(Vec3, Vec3); 2],
+        rng: [&mut R; 2],
+    ) -> [Option<(usize, f32)>; 2] {
+        use crate::lanes::{Avx8, Pair};
+        self.oct_descend_pair::<Pair<Avx8>, Avx8, R>(start, xn, rng)
     }
 
     /// Probability that [`LightTree::sample_from`] from `start` returns `light` (0 if `light`

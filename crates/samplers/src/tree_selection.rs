@@ -199,8 +199,17 @@ impl LightSelection for TreeSelection {
             }
             Some(cut) => {
                 // One fresh random number per cluster, rescaled down its subtree (as E&K and
-                // the authors' code).
-                for &node in &cut.nodes {
+                // the authors' code); the clusters two by two, their descents side by side.
+                let mut pairs = cut.nodes.chunks_exact(2);
+                for pair in &mut pairs {
+                    let (mut ua, mut ub) = (Rescaled(rng.next_u64()), Rescaled(rng.next_u64()));
+                    let found =
+                        tree.sample_pair_from([pair[0], pair[1]], [x; 2], [n; 2], [&mut ua, &mut ub]);
+                    for (light, pmf) in found.into_iter().flatten() {
+                        picks.push((light as u32, pmf));
+                    }
+                }
+                for &node in pairs.remainder() {
                     let mut u = Rescaled(rng.next_u64());
                     if let Some((light, pmf)) = tree.sample_from(node, x, n, &mut u) {
                         picks.push((light as u32, pmf));
