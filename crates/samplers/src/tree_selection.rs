@@ -101,7 +101,9 @@ crate::scratch_pool!(TreeScratch, |s| {
 /// The method replays one per BRDF-aware sample and asks for the memo
 /// ([`TreeState::with_cached_pmf`]).
 pub struct TreeState {
-    scratch: Pooled<TreeScratch>,
+    /// The cut and the lane memo; none for a single descent without the memo (which needs
+    /// neither, and so skips the loan).
+    scratch: Option<Pooled<TreeScratch>>,
     split: bool,
     cached_pmf: bool,
     x: Vec3,
@@ -116,24 +118,29 @@ impl TreeState {
 
     /// The cut's nodes (sorted DFS ids), if the selection splits.
     pub fn cut(&self) -> Option<&Cut> {
-        self.split.then_some(&self.scratch.cut)
+        match (&self.scratch, self.split) {
+            (Some(s), true) => Some(&s.cut),
+            _ => None,
+        }
     }
 
     /// This state's pmf replays keep the oct lanes they evaluate for the next replay (bit for
     /// bit the same pmfs): for a caller that replays many at one shading point.
     pub fn with_cached_pmf(mut self) -> Self {
         self.cached_pmf = true;
+        self.scratch.get_or_insert_with(Pooled::take);
         self
     }
 
     /// [`LightTree::pmf_from`] from `start`, through the lane memo if the state keeps one.
     fn pmf_from(&self, tree: &LightTree, start: NodeId, light: usize) -> f32 {
         let (x, n) = (self.x, self.n);
-        if self.cached_pmf {
-            let mut lanes = self.scratch.lanes.borrow_mut();
-            tree.pmf_from_cached(start, x, n, light, &mut *lanes)
-        } else {
-            tree.pmf_from(start, x, n, light)
+        match (&self.scratch, self.cached_pmf) {
+            (Some(s), true) => {
+                let mut lanes = s.lanes.borrow_mut();
+                tree.pmf_from_cached(start, x, n, light, &mut *lanes)
+            }
+            _ => tree.pmf_from(start, x, n, light),
         }
     }
 }
@@ -145,18 +152,18 @@ impl TreeSelection {
     }
 
     fn prepare_impl(&self, sp: &ShadingPoint, cap: Option<usize>) -> TreeState {
-        let mut scratch = Pooled::<TreeScratch>::take();
         let (x, n) = (sp.point(), sp.bsdf.ng);
-        let split = match (&self.tree, self.mode) {
+        let (scratch, split) = match (&self.tree, self.mode) {
             (Some(t), TreeMode::Split(mut params)) => {
                 if let Some(cap) = cap {
                     params.max_size = params.max_size.min(cap);
                 }
+                let mut scratch = Pooled::<TreeScratch>::take();
                 let TreeScratch { cut, queue, .. } = &mut *scratch;
                 t.adaptive_cut_into(cut, queue, x, n, &params);
-                true
+                (Some(scratch), true)
             }
-            _ => false,
+            _ => (None, false),
         };
         TreeState {
             scratch,
