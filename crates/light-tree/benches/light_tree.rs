@@ -97,13 +97,22 @@ fn bench_build(c: &mut Criterion) {
     g.finish();
 }
 
-fn bench_queries(c: &mut Criterion) {
-    let qs = queries();
-    let mut g = c.benchmark_group("sample+pmf");
+/// A group of `QUERIES` queries per iteration.
+fn query_group<'a>(
+    c: &'a mut Criterion,
+    name: &str,
+) -> criterion::BenchmarkGroup<'a, criterion::measurement::WallTime> {
+    let mut g = c.benchmark_group(name);
     g.sample_size(20)
         .warm_up_time(Duration::from_millis(500))
         .measurement_time(Duration::from_secs(2));
     g.throughput(Throughput::Elements(QUERIES as u64));
+    g
+}
+
+fn bench_queries(c: &mut Criterion) {
+    let qs = queries();
+    let mut g = query_group(c, "sample+pmf");
     let trees: Vec<(usize, LightTree)> = SIZES
         .iter()
         .map(|&n| (n, LightTree::build(&lights(n)).unwrap()))
@@ -124,11 +133,7 @@ fn bench_queries(c: &mut Criterion) {
     g.finish();
     // The same descents (without the replays), one at a time and two side by side.
     for paired in [false, true] {
-        let mut g = c.benchmark_group(if paired { "sample, paired" } else { "sample, single" });
-        g.sample_size(20)
-            .warm_up_time(Duration::from_millis(500))
-            .measurement_time(Duration::from_secs(2));
-        g.throughput(Throughput::Elements(QUERIES as u64));
+        let mut g = query_group(c, if paired { "sample, paired" } else { "sample, single" });
         for (n, tree) in &trees {
             g.bench_with_input(BenchmarkId::from_parameter(n), tree, |b, tree| {
                 b.iter(|| {
@@ -159,11 +164,7 @@ fn bench_queries(c: &mut Criterion) {
         }
         g.finish();
     }
-    let mut g = c.benchmark_group("adaptive_cut(0.85,64)");
-    g.sample_size(20)
-        .warm_up_time(Duration::from_millis(500))
-        .measurement_time(Duration::from_secs(2));
-    g.throughput(Throughput::Elements(QUERIES as u64));
+    let mut g = query_group(c, "adaptive_cut(0.85,64)");
     for (n, tree) in &trees {
         g.bench_with_input(BenchmarkId::from_parameter(n), tree, |b, tree| {
             b.iter(|| {

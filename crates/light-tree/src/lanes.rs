@@ -152,118 +152,69 @@ pair_op!(Sub, sub);
 pair_op!(Mul, mul);
 pair_op!(Div, div);
 
-impl<L: Lanes<4>> Lanes<8> for Pair<L> {
-    #[inline(always)]
-    fn load(v: [f32; 8]) -> Self {
-        Pair(
-            L::load([v[0], v[1], v[2], v[3]]),
-            L::load([v[4], v[5], v[6], v[7]]),
-        )
-    }
-    #[inline(always)]
-    fn splat(v: f32) -> Self {
-        Pair(L::splat(v), L::splat(v))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        Pair(self.0.sqrt(), self.1.sqrt())
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        Pair(self.0.min(o.0), self.1.min(o.1))
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        Pair(self.0.max(o.0), self.1.max(o.1))
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        Pair(self.0.abs(), self.1.abs())
-    }
-    #[inline(always)]
-    fn le(self, o: Self) -> Self {
-        Pair(self.0.le(o.0), self.1.le(o.1))
-    }
-    #[inline(always)]
-    fn ge(self, o: Self) -> Self {
-        Pair(self.0.ge(o.0), self.1.ge(o.1))
-    }
-    #[inline(always)]
-    fn and(self, o: Self) -> Self {
-        Pair(self.0.and(o.0), self.1.and(o.1))
-    }
-    #[inline(always)]
-    fn or(self, o: Self) -> Self {
-        Pair(self.0.or(o.0), self.1.or(o.1))
-    }
-    #[inline(always)]
-    fn andnot(self, o: Self) -> Self {
-        Pair(self.0.andnot(o.0), self.1.andnot(o.1))
-    }
-    #[inline(always)]
-    fn out(self) -> [f32; 8] {
-        let (a, b) = (self.0.out(), self.1.out());
-        [a[0], a[1], a[2], a[3], b[0], b[1], b[2], b[3]]
-    }
+/// `Lanes<$full>` as two `Lanes<$half>`, each operation on both halves.
+macro_rules! pair_lanes {
+    ($half:literal, $full:literal) => {
+        impl<L: Lanes<$half>> Lanes<$full> for Pair<L> {
+            #[inline(always)]
+            fn load(v: [f32; $full]) -> Self {
+                let (mut a, mut b) = ([0.0f32; $half], [0.0f32; $half]);
+                a.copy_from_slice(&v[..$half]);
+                b.copy_from_slice(&v[$half..]);
+                Pair(L::load(a), L::load(b))
+            }
+            #[inline(always)]
+            fn splat(v: f32) -> Self {
+                Pair(L::splat(v), L::splat(v))
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                Pair(self.0.sqrt(), self.1.sqrt())
+            }
+            #[inline(always)]
+            fn min(self, o: Self) -> Self {
+                Pair(self.0.min(o.0), self.1.min(o.1))
+            }
+            #[inline(always)]
+            fn max(self, o: Self) -> Self {
+                Pair(self.0.max(o.0), self.1.max(o.1))
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                Pair(self.0.abs(), self.1.abs())
+            }
+            #[inline(always)]
+            fn le(self, o: Self) -> Self {
+                Pair(self.0.le(o.0), self.1.le(o.1))
+            }
+            #[inline(always)]
+            fn ge(self, o: Self) -> Self {
+                Pair(self.0.ge(o.0), self.1.ge(o.1))
+            }
+            #[inline(always)]
+            fn and(self, o: Self) -> Self {
+                Pair(self.0.and(o.0), self.1.and(o.1))
+            }
+            #[inline(always)]
+            fn or(self, o: Self) -> Self {
+                Pair(self.0.or(o.0), self.1.or(o.1))
+            }
+            #[inline(always)]
+            fn andnot(self, o: Self) -> Self {
+                Pair(self.0.andnot(o.0), self.1.andnot(o.1))
+            }
+            #[inline(always)]
+            fn out(self) -> [f32; $full] {
+                let mut v = [0.0f32; $full];
+                v[..$half].copy_from_slice(&self.0.out());
+                v[$half..].copy_from_slice(&self.1.out());
+                v
+            }
+        }
+    };
 }
-
-impl<L: Lanes<8>> Lanes<16> for Pair<L> {
-    #[inline(always)]
-    fn load(v: [f32; 16]) -> Self {
-        let mut a = [0.0f32; 8];
-        let mut b = [0.0f32; 8];
-        a.copy_from_slice(&v[..8]);
-        b.copy_from_slice(&v[8..]);
-        Pair(L::load(a), L::load(b))
-    }
-    #[inline(always)]
-    fn splat(v: f32) -> Self {
-        Pair(L::splat(v), L::splat(v))
-    }
-    #[inline(always)]
-    fn sqrt(self) -> Self {
-        Pair(self.0.sqrt(), self.1.sqrt())
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        Pair(self.0.min(o.0), self.1.min(o.1))
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        Pair(self.0.max(o.0), self.1.max(o.1))
-    }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        Pair(self.0.abs(), self.1.abs())
-    }
-    #[inline(always)]
-    fn le(self, o: Self) -> Self {
-        Pair(self.0.le(o.0), self.1.le(o.1))
-    }
-    #[inline(always)]
-    fn ge(self, o: Self) -> Self {
-        Pair(self.0.ge(o.0), self.1.ge(o.1))
-    }
-    #[inline(always)]
-    fn and(self, o: Self) -> Self {
-        Pair(self.0.and(o.0), self.1.and(o.1))
-    }
-    #[inline(always)]
-    fn or(self, o: Self) -> Self {
-        Pair(self.0.or(o.0), self.1.or(o.1))
-    }
-    #[inline(always)]
-    fn andnot(self, o: Self) -> Self {
-        Pair(self.0.andnot(o.0), self.1.andnot(o.1))
-    }
-    #[inline(always)]
-    fn out(self) -> [f32; 16] {
-        let mut v = [0.0f32; 16];
-        v[..8].copy_from_slice(&self.0.out());
-        v[8..].copy_from_slice(&self.1.out());
-        v
-    }
-}
+pair_lanes!(4, 8);
+pair_lanes!(8, 16);
 
 #[cfg(target_arch = "x86_64")]
 pub(crate) use x86::{Avx8, Sse4};
