@@ -133,7 +133,12 @@ fn bench_queries(c: &mut Criterion) {
     g.finish();
     // The same descents (without the replays), one at a time and two side by side.
     for paired in [false, true] {
-        let mut g = query_group(c, if paired { "sample, paired" } else { "sample, single" });
+        let name = if paired {
+            "sample, paired"
+        } else {
+            "sample, single"
+        };
+        let mut g = query_group(c, name);
         for (n, tree) in &trees {
             g.bench_with_input(BenchmarkId::from_parameter(n), tree, |b, tree| {
                 b.iter(|| {

@@ -457,7 +457,11 @@ pub(crate) fn receiver<const N: usize, L: Lanes<N>>(x: Vec3, n: Vec3) -> LaneRec
     LaneReceiver {
         x: [L::splat(x.x), L::splat(x.y), L::splat(x.z)],
         n: [L::splat(n.x), L::splat(n.y), L::splat(n.z)],
-        n_abs: [L::splat(n.x.abs()), L::splat(n.y.abs()), L::splat(n.z.abs())],
+        n_abs: [
+            L::splat(n.x.abs()),
+            L::splat(n.y.abs()),
+            L::splat(n.z.abs()),
+        ],
         has_n: n != Vec3::ZERO,
     }
 }

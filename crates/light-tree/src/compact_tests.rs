@@ -344,7 +344,8 @@ fn paired_descents_equal_the_single_ones() {
                     [q[0].1, q[1].1],
                     [&mut pa, &mut pb],
                 );
-                let bits = |r: [Option<(usize, f32)>; 2]| r.map(|o| o.map(|(l, p)| (l, p.to_bits())));
+                let bits =
+                    |r: [Option<(usize, f32)>; 2]| r.map(|o| o.map(|(l, p)| (l, p.to_bits())));
                 assert_eq!(bits(paired), bits(single));
                 assert_eq!((pa.0, pb.0), (a.0, b.0));
             }

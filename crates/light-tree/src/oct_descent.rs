@@ -21,8 +21,8 @@
 //! [`Rescaled`]: crate::Rescaled
 
 use crate::compact::{LEAF_BIT, receiver_pair, slots_evaluated_for, slots_importance};
-use crate::oct::TwoOcts;
 use crate::lanes::{Fast8, Lanes};
+use crate::oct::TwoOcts;
 use crate::query::{DescentRandom, choose, chosen, sanitize};
 use crate::{LightTree, NodeId};
 use glam::Vec3;
@@ -235,7 +235,12 @@ impl LightTree {
     /// A descent's binary steps from `start` down to a depth divisible by 3 (none from such a
     /// depth): where it enters the octs, or its end.
     #[inline(always)]
-    fn oct_entry<R: DescentRandom>(&self, start: NodeId, (x, n): (Vec3, Vec3), rng: &mut R) -> Entry {
+    fn oct_entry<R: DescentRandom>(
+        &self,
+        start: NodeId,
+        (x, n): (Vec3, Vec3),
+        rng: &mut R,
+    ) -> Entry {
         let mut id = start;
         let mut pmf = 1.0f32;
         while !self.nodes[id as usize].depth().is_multiple_of(3) {
@@ -278,7 +283,13 @@ impl LightTree {
 
     /// One step from `oct`, whose sanitised lanes are `g`: the next oct, or the end.
     #[inline(always)]
-    fn oct_step<R: DescentRandom>(&self, oct: u32, g: &[f32; 8], pmf: &mut f32, rng: &mut R) -> Step {
+    fn oct_step<R: DescentRandom>(
+        &self,
+        oct: u32,
+        g: &[f32; 8],
+        pmf: &mut f32,
+        rng: &mut R,
+    ) -> Step {
         let Some((lane, f)) = pick(g, rng) else {
             return Step::Done(None);
         };

@@ -210,8 +210,12 @@ impl LightSelection for TreeSelection {
                 let mut pairs = cut.nodes.chunks_exact(2);
                 for pair in &mut pairs {
                     let (mut ua, mut ub) = (Rescaled(rng.next_u64()), Rescaled(rng.next_u64()));
-                    let found =
-                        tree.sample_pair_from([pair[0], pair[1]], [x; 2], [n; 2], [&mut ua, &mut ub]);
+                    let found = tree.sample_pair_from(
+                        [pair[0], pair[1]],
+                        [x; 2],
+                        [n; 2],
+                        [&mut ua, &mut ub],
+                    );
                     for (light, pmf) in found.into_iter().flatten() {
                         picks.push((light as u32, pmf));
                     }
