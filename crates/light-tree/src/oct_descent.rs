@@ -73,6 +73,17 @@ struct Ek<L> {
     lanes: PhantomData<L>,
 }
 
+impl<L> Ek<L> {
+    #[inline(always)]
+    fn at((x, n): (Vec3, Vec3)) -> Self {
+        Ek {
+            x,
+            n,
+            lanes: PhantomData,
+        }
+    }
+}
+
 impl<L: Lanes<8>> OctLanes for Ek<L> {
     #[inline(always)]
     fn lanes(&mut self, tree: &LightTree, oct: u32) -> [f32; 8] {
@@ -217,19 +228,16 @@ enum Step {
 }
 
 impl LightTree {
-    /// The descent of [`LightTree::sample_from`] on lanes `W`.
+    /// The descent of [`LightTree::sample_from`] on lanes `L8`.
     #[inline(always)]
-    fn oct_descend<W: OctLanes, R: DescentRandom>(
+    fn oct_descend<L8: Lanes<8>, R: DescentRandom>(
         &self,
         start: NodeId,
         xn: (Vec3, Vec3),
-        weights: &mut W,
         rng: &mut R,
     ) -> Option<(usize, f32)> {
-        match self.oct_entry(start, xn, rng) {
-            Entry::Done(found) => found,
-            Entry::Oct(oct, pmf) => self.oct_steps(oct, pmf, weights, rng),
-        }
+        let entry = self.oct_entry(start, xn, rng);
+        self.oct_finish::<L8, R>(entry, xn, rng)
     }
 
     /// A descent's binary steps from `start` down to a depth divisible by 3 (none from such a
@@ -350,19 +358,12 @@ impl LightTree {
     fn oct_finish<L8: Lanes<8>, R: DescentRandom>(
         &self,
         entry: Entry,
-        (x, n): (Vec3, Vec3),
+        xn: (Vec3, Vec3),
         rng: &mut R,
     ) -> Option<(usize, f32)> {
         match entry {
             Entry::Done(found) => found,
-            Entry::Oct(oct, pmf) => {
-                let mut ek = Ek::<L8> {
-                    x,
-                    n,
-                    lanes: PhantomData,
-                };
-                self.oct_steps(oct, pmf, &mut ek, rng)
-            }
+            Entry::Oct(oct, pmf) => self.oct_steps(oct, pmf, &mut Ek::<L8>::at(xn), rng),
         }
     }
 
@@ -470,12 +471,7 @@ impl LightTree {
             // `set_descent_simd`).
             return unsafe { self.sample_from_avx2(start, x, n, rng) };
         }
-        let mut ek = Ek::<Fast8> {
-            x,
-            n,
-            lanes: PhantomData,
-        };
-        self.oct_descend(start, (x, n), &mut ek, rng)
+        self.oct_descend::<Fast8, R>(start, (x, n), rng)
     }
 
     #[cfg(target_arch = "x86_64")]
@@ -487,12 +483,7 @@ impl LightTree {
         n: Vec3,
         rng: &mut R,
     ) -> Option<(usize, f32)> {
-        let mut ek = Ek::<crate::lanes::Avx8> {
-            x,
-            n,
-            lanes: PhantomData,
-        };
-        self.oct_descend(start, (x, n), &mut ek, rng)
+        self.oct_descend::<crate::lanes::Avx8, R>(start, (x, n), rng)
     }
 
     /// Two independent descents at once, `[sample_from(start[0], x[0], n[0], rng[0]),
@@ -550,11 +541,7 @@ impl LightTree {
             // SAFETY: as in `sample_from`.
             return unsafe { self.pmf_from_avx2(start, x, n, light, cache) };
         }
-        let ek = Ek::<Fast8> {
-            x,
-            n,
-            lanes: PhantomData,
-        };
+        let ek = Ek::<Fast8>::at((x, n));
         self.oct_replay(start, (x, n), &mut CachedEk { ek, cache }, light)
     }
 
@@ -568,23 +555,14 @@ impl LightTree {
         light: usize,
         cache: &mut C,
     ) -> f32 {
-        let ek = Ek::<crate::lanes::Avx8> {
-            x,
-            n,
-            lanes: PhantomData,
-        };
+        let ek = Ek::<crate::lanes::Avx8>::at((x, n));
         self.oct_replay(start, (x, n), &mut CachedEk { ek, cache }, light)
     }
 
     /// The eight lanes of oct `oct` at (x, n) on lanes `L` (tests).
     #[cfg(test)]
     pub(crate) fn oct_lanes<L: Lanes<8>>(&self, oct: u32, x: Vec3, n: Vec3) -> [f32; 8] {
-        Ek::<L> {
-            x,
-            n,
-            lanes: PhantomData,
-        }
-        .lanes(self, oct)
+        Ek::<L>::at((x, n)).lanes(self, oct)
     }
 }
 
