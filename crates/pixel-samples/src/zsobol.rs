@@ -112,17 +112,27 @@ fn shuffle_digits(z: &ZOrder, pair: u64) -> u64 {
 }
 
 /// The second Sobol dimension at a 64-bit index, as a 32-bit fraction.
+///
+/// Its generator matrix is Pascal's triangle mod 2: index bit k adds C(k, j) mod 2 to bit
+/// 63 − j of the result. Read as polynomials over GF(2), that maps f(t) = Σ x_k t^k to
+/// f(t + 1), and (t + 1)^k factors over the set bits b of k into (t^(2^b) + 1): one shift,
+/// mask and xor per bit of the exponent, six in all, instead of a loop over the index's
+/// bits. The same linear map, so the same bits (`pascal_shift_is_the_direction_loop`).
 #[inline]
-pub(crate) fn sobol_second_64(mut index: u64) -> u32 {
-    let (mut v, mut r) = (1u64 << 63, 0u64);
-    while index != 0 {
-        if index & 1 != 0 {
-            r ^= v;
-        }
-        index >>= 1;
-        v ^= v >> 1;
+pub(crate) fn sobol_second_64(index: u64) -> u32 {
+    const KEEP: [u64; 6] = [
+        0x5555_5555_5555_5555,
+        0x3333_3333_3333_3333,
+        0x0f0f_0f0f_0f0f_0f0f,
+        0x00ff_00ff_00ff_00ff,
+        0x0000_ffff_0000_ffff,
+        0x0000_0000_ffff_ffff,
+    ];
+    let mut y = index;
+    for (b, keep) in KEEP.iter().enumerate() {
+        y ^= (y >> (1u32 << b)) & keep;
     }
-    (r >> 32) as u32
+    (y.reverse_bits() >> 32) as u32
 }
 
 /// The `zsobol` value (a 32-bit fraction) of dimension `dim` of the sample at `z`.
@@ -139,6 +149,35 @@ pub(crate) fn zsobol_value(z: &ZOrder, dim: u32) -> u32 {
 
 #[cfg(test)]
 mod tests {
+
+    /// The direction numbers v₁ = 2⁶³, v_{k+1} = v_k ⊕ (v_k ≫ 1), xored for the set bits.
+    fn direction_loop(mut index: u64) -> u32 {
+        let (mut v, mut r) = (1u64 << 63, 0u64);
+        while index != 0 {
+            if index & 1 != 0 {
+                r ^= v;
+            }
+            index >>= 1;
+            v ^= v >> 1;
+        }
+        (r >> 32) as u32
+    }
+
+    /// Both maps are linear over GF(2), so agreeing on every unit index proves them equal;
+    /// a few thousand others check the xor of several bits too.
+    #[test]
+    fn pascal_shift_is_the_direction_loop() {
+        for k in 0..64 {
+            assert_eq!(sobol_second_64(1 << k), direction_loop(1 << k), "bit {k}");
+        }
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for i in 0..5000u64 {
+            x = mix64(x ^ i);
+            for index in [x, x & 0xffff_ffff, i] {
+                assert_eq!(sobol_second_64(index), direction_loop(index));
+            }
+        }
+    }
     use super::*;
 
     #[test]
