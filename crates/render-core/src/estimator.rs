@@ -35,6 +35,31 @@ impl ShadingPoint {
     /// shadow ray only when the unshadowed value is non-zero.
     pub fn shade(&self, scene: &Scene, s: &LightSample, counters: &mut Counters) -> Vec3 {
         let f = self.bsdf.eval_cos(self.wo, s.wi) * s.radiance;
+        self.unless_occluded(scene, s, f, counters)
+    }
+
+    /// [`ShadingPoint::shade`] and the BSDF's sampling density of the light sample's direction
+    /// (for its MIS weight), both from one BSDF evaluation.
+    pub fn shade_with_pdf(
+        &self,
+        scene: &Scene,
+        s: &LightSample,
+        counters: &mut Counters,
+    ) -> (Vec3, f32) {
+        let v = self.bsdf.eval(self.wo, s.wi);
+        let f = self.unless_occluded(scene, s, v.f_cos * s.radiance, counters);
+        (f, v.pdf)
+    }
+
+    /// `f`, or zero when it is zero or the light sample's shadow ray is blocked.
+    #[inline]
+    fn unless_occluded(
+        &self,
+        scene: &Scene,
+        s: &LightSample,
+        f: Vec3,
+        counters: &mut Counters,
+    ) -> Vec3 {
         if f == Vec3::ZERO {
             return Vec3::ZERO;
         }

@@ -35,7 +35,8 @@ pub const TECHNIQUE_LIGHT: usize = 0;
 pub const TECHNIQUE_BSDF: usize = 1;
 
 /// Samples a point on a picked light (`pmf`: its selection probability) and shades it:
-/// `(sample, pmf × point pdf, f·L with visibility)`, or `None` when it contributes nothing.
+/// `(sample, pmf × point pdf, f·L with visibility, the BSDF's density of its direction)`, or
+/// `None` when it contributes nothing.
 pub(crate) fn sample_pick(
     scene: &Scene,
     sp: &ShadingPoint,
@@ -43,15 +44,15 @@ pub(crate) fn sample_pick(
     pmf: f32,
     rng: &mut SampleStream,
     counters: &mut Counters,
-) -> Option<(LightSample, f32, Vec3)> {
+) -> Option<(LightSample, f32, Vec3, f32)> {
     let u = rng.next_2d();
     let s = scene.sample_light(light, sp.point(), u)?;
     let p = pmf * s.pdf;
     if !(p > 0.0) {
         return None;
     }
-    let f = sp.shade(scene, &s, counters);
-    (f != Vec3::ZERO).then_some((s, p, f))
+    let (f, p_bsdf) = sp.shade_with_pdf(scene, &s, counters);
+    (f != Vec3::ZERO).then_some((s, p, f, p_bsdf))
 }
 
 impl<S: LightSelection> DirectLighting for LightStrategy<S> {
@@ -91,12 +92,13 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
         let mut l = Vec3::ZERO;
         for &(light, pmf) in &picks.0 {
             ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
-            let Some((s, p_light, f)) = sample_pick(scene, sp, light, pmf, rng, ctx.counters)
+            let Some((s, p_light, f, p_bsdf)) =
+                sample_pick(scene, sp, light, pmf, rng, ctx.counters)
             else {
                 continue;
             };
             let w = if self.with_bsdf && !s.is_delta {
-                power2(p_light, sp.bsdf.pdf(sp.wo, s.wi))
+                power2(p_light, p_bsdf)
             } else {
                 1.0
             };

@@ -53,8 +53,32 @@ impl Ggx {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
+        self.eval_cos_at(&self.pair(wo, wi), wo, wi)
+    }
+
+    /// What the value and the density of one pair of directions (both above the horizon) share.
+    #[inline]
+    pub fn pair(&self, wo: Vec3, wi: Vec3) -> PairTerms {
         let h = (wo + wi).normalize();
-        self.d(h) * self.g2(wo, wi) / (4.0 * wo.z)
+        PairTerms {
+            h,
+            d: self.d(h),
+            lambda_o: self.lambda(wo),
+        }
+    }
+
+    /// [`Ggx::eval_cos`] from the shared terms of (wo, wi).
+    #[inline]
+    pub fn eval_cos_at(&self, t: &PairTerms, wo: Vec3, wi: Vec3) -> f32 {
+        let g2 = 1.0 / (1.0 + t.lambda_o + self.lambda(wi));
+        t.d * g2 / (4.0 * wo.z)
+    }
+
+    /// [`Ggx::reflection_pdf`] from the shared terms of (wo, wi).
+    #[inline]
+    pub fn reflection_pdf_at(&self, t: &PairTerms, wo: Vec3) -> f32 {
+        let g1 = 1.0 / (1.0 + t.lambda_o);
+        g1 * t.d / (4.0 * wo.z)
     }
 
     /// Sample a visible normal for `wo` (wo.z > 0).
@@ -83,9 +107,17 @@ impl Ggx {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let h = (wo + wi).normalize();
-        self.g1(wo) * self.d(h) / (4.0 * wo.z)
+        self.reflection_pdf_at(&self.pair(wo, wi), wo)
     }
+}
+
+/// The half vector of a pair of directions, D there and Smith Λ(wo): what the BRDF's value and
+/// its sampling density have in common, computed once when both are wanted.
+#[derive(Clone, Copy, Debug)]
+pub struct PairTerms {
+    pub h: Vec3,
+    pub d: f32,
+    pub lambda_o: f32,
 }
 
 pub fn reflect(w: Vec3, n: Vec3) -> Vec3 {

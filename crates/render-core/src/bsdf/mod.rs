@@ -15,7 +15,7 @@ pub use params::{BsdfParams, Specular};
 use crate::colour::luminance;
 use crate::frame::Frame;
 use glam::{Vec2, Vec3};
-use microfacet::{Ggx, reflect};
+use microfacet::{Ggx, PairTerms, reflect};
 use std::f32::consts::PI;
 
 #[derive(Clone, Copy, Debug)]
@@ -26,6 +26,13 @@ pub struct Bsdf {
     pub ng: Vec3,
     pub params: BsdfParams,
     pub ggx: Ggx,
+}
+
+/// f · |cos θi| and the solid-angle density of one direction.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfValue {
+    pub f_cos: Vec3,
+    pub pdf: f32,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -93,39 +100,79 @@ impl Bsdf {
         wo.dot(self.ng) > 0.0 && wi.dot(self.ng) > 0.0
     }
 
-    /// f(wo, wi) · cos θi (shading normal).
-    pub fn eval_cos(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+    /// Both directions in the shading frame, if both lie above the geometric and the shading
+    /// surface (else the value and the density are zero).
+    #[inline]
+    fn local_pair(&self, wo: Vec3, wi: Vec3) -> Option<(Vec3, Vec3)> {
         if !self.valid(wo, wi) {
-            return Vec3::ZERO;
+            return None;
         }
         let lo = self.frame.to_local(wo);
         let li = self.frame.to_local(wi);
         if lo.z <= 0.0 || li.z <= 0.0 {
-            return Vec3::ZERO;
+            return None;
         }
+        Some((lo, li))
+    }
+
+    /// The glossy lobe's shared terms at (lo, li), if it has one.
+    #[inline]
+    fn glossy_terms(&self, lo: Vec3, li: Vec3) -> Option<PairTerms> {
+        (!self.is_pure_diffuse()).then(|| self.ggx.pair(lo, li))
+    }
+
+    #[inline]
+    fn f_cos_local(&self, lo: Vec3, li: Vec3, glossy: Option<&PairTerms>) -> Vec3 {
         let mut f = self.params.diffuse * (li.z / PI);
-        if !self.is_pure_diffuse() {
-            let h = (lo + li).normalize();
-            f += self.params.specular.weight(li.dot(h)) * self.ggx.eval_cos(lo, li);
+        if let Some(t) = glossy {
+            f += self.params.specular.weight(li.dot(t.h)) * self.ggx.eval_cos_at(t, lo, li);
         }
         f
     }
 
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if !self.valid(wo, wi) {
-            return 0.0;
-        }
-        let lo = self.frame.to_local(wo);
-        let li = self.frame.to_local(wi);
-        if lo.z <= 0.0 || li.z <= 0.0 {
-            return 0.0;
-        }
+    #[inline]
+    fn pdf_local(&self, lo: Vec3, li: Vec3, glossy: Option<&PairTerms>) -> f32 {
         let ps = self.specular_probability(lo);
         let mut pdf = (1.0 - ps) * li.z / PI;
-        if ps > 0.0 {
-            pdf += ps * self.ggx.reflection_pdf(lo, li);
+        if ps > 0.0
+            && let Some(t) = glossy
+        {
+            pdf += ps * self.ggx.reflection_pdf_at(t, lo);
         }
         pdf
+    }
+
+    /// f(wo, wi) · cos θi (shading normal).
+    pub fn eval_cos(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        let Some((lo, li)) = self.local_pair(wo, wi) else {
+            return Vec3::ZERO;
+        };
+        self.f_cos_local(lo, li, self.glossy_terms(lo, li).as_ref())
+    }
+
+    /// Solid-angle density with which [`Bsdf::sample`] picks `wi`.
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let Some((lo, li)) = self.local_pair(wo, wi) else {
+            return 0.0;
+        };
+        self.pdf_local(lo, li, self.glossy_terms(lo, li).as_ref())
+    }
+
+    /// [`Bsdf::eval_cos`] and [`Bsdf::pdf`] of one direction from one evaluation (the frame
+    /// change, the half vector, D and Λ(wo) shared), bit for bit what the two give.
+    #[inline]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> BsdfValue {
+        let Some((lo, li)) = self.local_pair(wo, wi) else {
+            return BsdfValue {
+                f_cos: Vec3::ZERO,
+                pdf: 0.0,
+            };
+        };
+        let glossy = self.glossy_terms(lo, li);
+        BsdfValue {
+            f_cos: self.f_cos_local(lo, li, glossy.as_ref()),
+            pdf: self.pdf_local(lo, li, glossy.as_ref()),
+        }
     }
 
     /// Sample a direction: `u_lobe` picks the lobe, `u` drives it.
@@ -145,14 +192,14 @@ impl Bsdf {
             return None;
         }
         let wi = self.frame.to_world(li);
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
+        let v = self.eval(wo, wi);
+        if v.pdf <= 0.0 {
             return None;
         }
         Some(BsdfSample {
             wi,
-            f_cos: self.eval_cos(wo, wi),
-            pdf,
+            f_cos: v.f_cos,
+            pdf: v.pdf,
         })
     }
 }
@@ -221,6 +268,31 @@ mod tests {
                 assert_eq!(s.pdf, b.pdf(wo, s.wi));
                 assert_eq!(s.f_cos, b.eval_cos(wo, s.wi));
                 assert!(s.pdf > 0.0 && s.f_cos.is_finite());
+            }
+        }
+    }
+
+    /// The one-evaluation `eval` gives `eval_cos` and `pdf` bit for bit, in every lobe mix and
+    /// for directions below either surface (a shading normal tilted off the geometric one).
+    #[test]
+    fn eval_is_eval_cos_and_pdf() {
+        let mut r = SampleStream::new(5, 0, 0);
+        let cases = [
+            (0.01, 0.3, 0.04),
+            (0.4, 0.0, 1.0),
+            (1.0, 0.8, 0.0),
+            (0.2, 0.5, 0.5),
+        ];
+        for (alpha, kd, f0) in cases {
+            for _ in 0..2000 {
+                let wo = crate::sampling::uniform_sphere(r.next_2d());
+                let wi = crate::sampling::uniform_sphere(r.next_2d());
+                let ns = (Vec3::Z + 0.3 * crate::sampling::uniform_sphere(r.next_2d())).normalize();
+                let mut b = bsdf(alpha, kd, f0, wo);
+                b.frame = Frame::from_normal_and_direction(ns, wo);
+                let v = b.eval(wo, wi);
+                assert_eq!(v.f_cos, b.eval_cos(wo, wi));
+                assert_eq!(v.pdf.to_bits(), b.pdf(wo, wi).to_bits());
             }
         }
     }

@@ -65,6 +65,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
         wi: Vec3,
         delta: bool,
         own: usize,
+        bsdf_pdf: Option<f32>,
     ) -> [f32; 3] {
         let (scene, sp) = (self.scene, self.sp);
         let l = &scene.lights[light];
@@ -87,7 +88,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
         let p_bsdf = if delta || own == TECHNIQUE_BSDF {
             0.0
         } else {
-            sp.bsdf.pdf(sp.wo, wi)
+            bsdf_pdf.unwrap_or_else(|| sp.bsdf.pdf(sp.wo, wi))
         };
         [p_ls, p_bo, p_bsdf]
     }
@@ -109,10 +110,12 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
                     let u = rng.next_2d();
                     let memory = &mut ctx.pixel_memory[LEARNED_SLOT..];
                     sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, sel, st)
+                        .map(|(s, p, f)| (s, p, f, None))
                 }
-                LsState::Tree(..) => sample_pick(scene, sp, light, pmf, rng, ctx.counters),
+                LsState::Tree(..) => sample_pick(scene, sp, light, pmf, rng, ctx.counters)
+                    .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf))),
             };
-            let Some((s, p_ls, f)) = sampled else {
+            let Some((s, p_ls, f, p_bsdf)) = sampled else {
                 continue;
             };
             let mut p = self.densities(
@@ -122,6 +125,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
                 s.wi,
                 s.is_delta,
                 TECHNIQUE_LS,
+                p_bsdf,
             );
             debug_assert!(
                 {
@@ -168,11 +172,19 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
         if !(p_bo > 0.0) {
             return;
         }
-        let f = sp.shade(scene, &s, ctx.counters);
+        let (f, p_bsdf) = sp.shade_with_pdf(scene, &s, ctx.counters);
         if f == Vec3::ZERO {
             return;
         }
-        let mut p = self.densities(light, s.point, s.normal, s.wi, s.is_delta, TECHNIQUE_BO);
+        let mut p = self.densities(
+            light,
+            s.point,
+            s.normal,
+            s.wi,
+            s.is_delta,
+            TECHNIQUE_BO,
+            Some(p_bsdf),
+        );
         debug_assert!(
             (p[TECHNIQUE_BO] - p_bo).abs() <= 1e-3 * p_bo,
             "BO pdf at sampling {p_bo} vs replay {}",
@@ -215,6 +227,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
             b.wi,
             false,
             TECHNIQUE_BSDF,
+            None,
         );
         p[TECHNIQUE_BSDF] = b.pdf;
         taken.push(Taken {
