@@ -1,15 +1,15 @@
 //! Light sampling through a [`LightSelection`], optionally combined with BSDF sampling by
 //! MIS (power heuristic, one sample of each; a splitting selection counts as one sample).
-use crate::bsdf_sampling::sample_bsdf;
+use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
 use crate::mis::power2;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
-use render_core::Vec3;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
 use render_core::light::LightSample;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
+use render_core::{Vec2, Vec3};
 
 /// Light selection (one or several lights per shading point), with or without BSDF sampling
 /// combined by MIS, as a strategy.
@@ -24,10 +24,15 @@ pub struct LightStrategy<S: LightSelection> {
     pub parameters: serde_json::Value,
 }
 
-/// Per-thread buffer of the lights a selection picked at one shading point.
+/// Per-thread buffer of the lights a selection picked at one shading point (light, pmf).
 #[derive(Default)]
 pub struct Picks(pub Vec<(u32, f32)>);
 crate::scratch_pool!(Picks, |p| p.0.clear());
+
+/// Per-thread buffer of each pick's two numbers for its point on the light.
+#[derive(Default)]
+struct PickNumbers(Vec<Vec2>);
+crate::scratch_pool!(PickNumbers, |p| p.0.clear());
 
 /// Index of light sampling in the technique counters.
 pub const TECHNIQUE_LIGHT: usize = 0;
@@ -45,7 +50,18 @@ pub(crate) fn sample_pick(
     rng: &mut SampleStream,
     counters: &mut Counters,
 ) -> Option<(LightSample, f32, Vec3, f32)> {
-    let u = rng.next_2d();
+    sample_pick_at(scene, sp, light, pmf, rng.next_2d(), counters)
+}
+
+/// [`sample_pick`] with the point's two numbers given.
+fn sample_pick_at(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    light: u32,
+    pmf: f32,
+    u: Vec2,
+    counters: &mut Counters,
+) -> Option<(LightSample, f32, Vec3, f32)> {
     let s = scene.sample_light(light, sp.point(), u)?;
     let p = pmf * s.pdf;
     if !(p > 0.0) {
@@ -88,12 +104,29 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
             0,
             self.with_bsdf as usize,
         );
-        let x = sp.point();
+        // Every number is drawn first, in the order the samples use them, so that the picked
+        // lights' records (a cache miss each, among many lights) load while the BSDF ray is
+        // traced. The same numbers and the same sum in the same order: the same image.
+        let mut numbers = Pooled::<PickNumbers>::take();
+        numbers.0.extend(picks.0.iter().map(|_| rng.next_2d()));
+        let bsdf_numbers = self.with_bsdf.then(|| (rng.next_f32(), rng.next_2d()));
+        for &(light, _) in &picks.0 {
+            scene.prefetch_light(light);
+        }
+        let from_bsdf = bsdf_numbers.and_then(|(u_lobe, u)| {
+            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
+            let b = sample_bsdf_at(scene, sp, u_lobe, u, ctx.counters)?;
+            b.found_light().then(|| {
+                let p_light = self.selection.pmf(&state, sp, b.light)
+                    * scene.lights[b.light as usize].pdf(sp.point(), b.point, b.normal);
+                b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf)
+            })
+        });
         let mut l = Vec3::ZERO;
-        for &(light, pmf) in &picks.0 {
+        for (&(light, pmf), &u) in picks.0.iter().zip(&numbers.0) {
             ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
             let Some((s, p_light, f, p_bsdf)) =
-                sample_pick(scene, sp, light, pmf, rng, ctx.counters)
+                sample_pick_at(scene, sp, light, pmf, u, ctx.counters)
             else {
                 continue;
             };
@@ -104,15 +137,8 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
             };
             l += f * (w / p_light);
         }
-        if self.with_bsdf {
-            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
-            if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)
-                && b.found_light()
-            {
-                let p_light = self.selection.pmf(&state, sp, b.light)
-                    * scene.lights[b.light as usize].pdf(x, b.point, b.normal);
-                l += b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf);
-            }
+        if let Some(c) = from_bsdf {
+            l += c;
         }
         l
     }
