@@ -106,7 +106,9 @@ fn uses_variant(strategy: &str, variant: &str) -> bool {
     match variant {
         "default" => true,
         "reproduce" => strategy.starts_with("tree") || strategy.starts_with("mis3"),
-        "learned-visibility" => strategy.contains("learned"),
+        "learned-visibility" => {
+            strategy.contains("learned") && !strategy.starts_with("learned-descent")
+        }
         _ => strategy == "mis3-adaptive" || strategy == "ris-adaptive",
     }
 }

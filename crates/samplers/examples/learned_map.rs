@@ -47,6 +47,7 @@ fn main() -> Result<(), String> {
         name: "learned+bsdf".into(),
         selection: LearnedSelection::new(&scene, PowerUnits::Watts, config)?,
         with_bsdf: true,
+        light_samples: 1,
     };
     let camera = scene.camera(None).map_err(|e| e.to_string())?;
     let settings = RenderSettings {

@@ -251,6 +251,14 @@ pub fn strategies() -> Vec<StrategyInfo> {
         ),
         s("learned+bsdf", "learned + BSDF sampling, MIS"),
         s(
+            "learned-descent",
+            "learned descent (issue 25): the tree's descent with a factor per node of its top 11 levels, its contribution over its importance learnt per region in earlier passes (+20 % the plain descent)",
+        ),
+        s(
+            "learned-descent+bsdf",
+            "learned-descent + BSDF sampling, MIS",
+        ),
+        s(
             "oracle",
             "every light's unshadowed contribution per point, one light chosen ∝ it (+5 % power), + BSDF sampling, MIS: a floor, O(lights) per point",
         ),
@@ -359,7 +367,17 @@ pub fn create(
             selection: learned::selection::LearnedSelection::new(scene, units, opts.learned)
                 .map_err(StrategyError::BadOption)?,
             with_bsdf: name == "learned+bsdf",
+            light_samples: opts.learned.light_samples,
         }),
+        "learned-descent" | "learned-descent+bsdf" => {
+            Box::new(learned::strategy::LearnedStrategy {
+                name: name.into(),
+                selection: learned::descent::DescentSelection::new(scene, units, opts.learned)
+                    .map_err(StrategyError::BadOption)?,
+                with_bsdf: name == "learned-descent+bsdf",
+                light_samples: opts.learned.light_samples,
+            })
+        }
         "oracle" | "oracle-shadowed" => Box::new(LightStrategy {
             name: name.into(),
             selection: if name == "oracle" {

@@ -129,6 +129,11 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
             "cut": "breadth-first",
             "learned": opts.learned,
         }),
+        "learned-descent" | "learned-descent+bsdf" => json!({
+            "power_units": units(opts),
+            "levels": crate::learned::descent::LEVELS,
+            "learned": opts.learned,
+        }),
         "oracle" | "oracle-shadowed" => {
             let mut p = json!({
                 "defensive_power_fraction": oracle::DEFENSIVE,

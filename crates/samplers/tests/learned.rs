@@ -5,11 +5,13 @@
 //! learned selection as the method's LS technique) converges and is deterministic too.
 mod common;
 use chi2_test::chi2_test;
+use render_core::estimator::DirectLighting;
 use render_core::estimator::ShadingPoint;
 use render_core::render::{RenderResult, RenderSettings, render};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use samplers::convergence::compare;
+use samplers::learned::descent::DescentSelection;
 use samplers::learned::selection::LearnedSelection;
 use samplers::learned::strategy::LearnedStrategy;
 use samplers::learned::{LearnTarget, LearnedConfig};
@@ -30,6 +32,7 @@ fn learned(scene: &Scene, target: LearnTarget) -> LearnedStrategy {
         name: "learned+bsdf".into(),
         selection: LearnedSelection::new(scene, PowerUnits::Watts, config).unwrap(),
         with_bsdf: true,
+        light_samples: 1,
     }
 }
 
@@ -53,6 +56,8 @@ fn cases() -> Vec<(&'static str, (LearnTarget, u32))> {
         .to_vec();
     c.push(("learned+bsdf", (LearnTarget::Visibility, 1)));
     c.push(("learned+bsdf", (LearnTarget::Contribution, 3)));
+    c.push(("learned-descent+bsdf", (LearnTarget::Contribution, 1)));
+    c.push(("learned-descent", (LearnTarget::Contribution, 1)));
     c
 }
 
@@ -107,58 +112,171 @@ fn picks_follow_their_pmf(scene: &Scene, s: &LearnedStrategy) {
     let table = s.selection.table.read().unwrap();
     assert!(table.pass == 6 && !table.is_empty(), "it learnt something");
     let mut learnt_points = 0;
+    let tree = s.selection.tree.tree.as_ref().unwrap();
     for (i, sp) in camera_points(scene).iter().enumerate() {
         let state = s.selection.prepare_with(scene, sp, &table);
         if table.region(state.key).is_some() {
             learnt_points += 1;
         }
-        let n = scene.lights.len();
-        let expected: Vec<f64> = (0..n as u32)
-            .map(|l| s.selection.pmf(&state, sp, l) as f64)
-            .collect();
-        let total: f64 = expected.iter().sum();
-        assert!((total - 1.0).abs() < 1e-3, "pmf sums to {total}");
-        // Every light the unshadowed tree reaches stays reachable (the defensive share).
-        let tree = s.selection.tree.tree.as_ref().unwrap();
-        for l in 0..n {
-            if tree.pmf(sp.point(), sp.bsdf.ng, l) > 0.0 {
-                assert!(expected[l] > 0.0, "light {l} unreachable");
-            }
-        }
-        let samples = 200_000u64;
-        let mut observed = vec![0.0f64; n];
-        let mut picks = Vec::new();
-        for k in 0..samples {
-            let mut rng = SampleStream::new(11 + i as u64, k, 0);
-            picks.clear();
-            s.selection.pick(&state, sp, &mut rng, &mut picks);
-            for &(light, p) in &picks {
-                observed[light as usize] += 1.0;
-                // The probability at sampling is the one replayed, bit for bit.
-                assert_eq!(
-                    p.to_bits(),
-                    s.selection.pmf(&state, sp, light).to_bits(),
-                    "light {light}"
-                );
-            }
-        }
-        let expected: Vec<f64> = expected
-            .iter()
-            .map(|p| p * samples as f64 / total)
-            .collect();
-        let r = chi2_test(&observed, &expected);
-        assert!(
-            r.p_value > 1e-3,
-            "point {i}: chi2 {} dof {} p {}",
-            r.statistic,
-            r.dof,
-            r.p_value
-        );
+        picks_match_pmf(scene, &s.selection, &state, sp, i, tree);
     }
     assert!(
         learnt_points >= 3,
         "only {learnt_points} points in learnt regions"
     );
+}
+
+/// At `sp` with `state`: the pmf sums to one, every light the unshadowed tree reaches keeps a
+/// positive probability, picks follow the pmf (chi-square) and each pick's probability is the
+/// replayed pmf bit for bit.
+fn picks_match_pmf<S: LightSelection>(
+    scene: &Scene,
+    sel: &S,
+    state: &S::State,
+    sp: &ShadingPoint,
+    i: usize,
+    tree: &light_tree::LightTree,
+) {
+    let n = scene.lights.len();
+    let expected: Vec<f64> = (0..n as u32)
+        .map(|l| sel.pmf(state, sp, l) as f64)
+        .collect();
+    let total: f64 = expected.iter().sum();
+    assert!((total - 1.0).abs() < 1e-3, "pmf sums to {total}");
+    // Every light the unshadowed tree reaches stays reachable (the defensive share).
+    for l in 0..n {
+        if tree.pmf(sp.point(), sp.bsdf.ng, l) > 0.0 {
+            assert!(expected[l] > 0.0, "light {l} unreachable");
+        }
+    }
+    let samples = 200_000u64;
+    let mut observed = vec![0.0f64; n];
+    let mut picks = Vec::new();
+    for k in 0..samples {
+        let mut rng = SampleStream::new(11 + i as u64, k, 0);
+        picks.clear();
+        sel.pick(state, sp, &mut rng, &mut picks);
+        for &(light, p) in &picks {
+            observed[light as usize] += 1.0;
+            // The probability at sampling is the one replayed, bit for bit.
+            assert_eq!(
+                p.to_bits(),
+                sel.pmf(state, sp, light).to_bits(),
+                "light {light}"
+            );
+        }
+    }
+    let expected: Vec<f64> = expected
+        .iter()
+        .map(|p| p * samples as f64 / total)
+        .collect();
+    let r = chi2_test(&observed, &expected);
+    assert!(
+        r.p_value > 1e-3,
+        "point {i}: chi2 {} dof {} p {}",
+        r.statistic,
+        r.dof,
+        r.p_value
+    );
+}
+
+/// The learned descent, likewise, after 6 passes of learning.
+#[test]
+fn learned_descent_picks_follow_their_pmf_within_a_pass_and_replay_it() {
+    let scene = rooms();
+    let s = descent(&scene);
+    render(&scene, &s, &settings(&scene, (48, 32), 6, 2), &|_, _| {}).unwrap();
+    assert_eq!(s.parameters()["passes_learnt"], 6);
+    assert!(s.parameters()["regions"].as_u64().unwrap() > 0);
+    let tree = s.selection.tree.tree.as_ref().unwrap();
+    let mut learnt_points = 0;
+    for (i, sp) in camera_points(&scene).iter().enumerate() {
+        let state = s.selection.prepare(&scene, sp);
+        learnt_points += state.learnt() as usize;
+        picks_match_pmf(&scene, &s.selection, &state, sp, i, tree);
+    }
+    assert!(
+        learnt_points >= 3,
+        "only {learnt_points} points in learnt regions"
+    );
+}
+
+/// The learned descent's factors, exactly: with light a (under the root's left child) observed
+/// at ratio 4 on every level and light b (under the right child) at 0, ten times each, the
+/// root's factor is the mean ratio 2, the children's r̂_left = (40 + 2a)/(10 + a) and
+/// r̂_right = 2a/(10 + a), and the probability of the left subtree is
+/// (1 − α)·I_l r̂_l/(I_l r̂_l + I_r r̂_r) + α·I_l/(I_l + I_r).
+#[test]
+fn learned_descent_splits_by_the_observed_ratios() {
+    let scene = rooms();
+    let s = descent(&scene);
+    let sel = &s.selection;
+    let lt = sel.tree.tree.as_ref().unwrap();
+    let n = scene.lights.len() as u32;
+    let left = |l: u32| lt.bit_trail(l as usize) & 1 == 0;
+    let (a_light, b_light) = (
+        (0..n).find(|&l| left(l)).unwrap(),
+        (0..n).find(|&l| !left(l)).unwrap(),
+    );
+    let mut checked = 0;
+    for sp in camera_points(&scene) {
+        s.begin_render();
+        let before = sel.prepare(&scene, &sp);
+        let mut pixels = Vec::new();
+        for light in [a_light, b_light] {
+            let ratio = if light == a_light { 4.0 } else { 0.0 };
+            for _ in 0..10 {
+                let mut m = [0.0f32; render_core::estimator::PIXEL_MEMORY];
+                let ratios = [ratio; samplers::learned::descent::LEVELS];
+                samplers::learned::descent::write_observation(
+                    &mut m, 1, before.key, light, &ratios,
+                );
+                pixels.push(m);
+            }
+        }
+        s.end_pass(&mut pixels.iter());
+        let after = sel.prepare(&scene, &sp);
+        assert!(after.learnt() && !before.learnt());
+        let (x, nrm) = sel.tree.prepare(&scene, &sp).receiver();
+        let [il, ir] = lt
+            .child_importances(lt.root(), x, nrm)
+            .unwrap()
+            .map(|v| v as f64);
+        if !(il > 0.0 && ir > 0.0) {
+            continue;
+        }
+        let a = sel.config.prior_strength as f64;
+        let (fl, fr) = ((40.0 + 2.0 * a) / (10.0 + a), 2.0 * a / (10.0 + a));
+        let alpha = sel.config.defensive as f64;
+        let expected = (1.0 - alpha) * il * fl / (il * fl + ir * fr) + alpha * il / (il + ir);
+        let mass = |st| -> f64 {
+            (0..n)
+                .filter(|&l| left(l))
+                .map(|l| sel.pmf(st, &sp, l) as f64)
+                .sum()
+        };
+        assert!(
+            (mass(&before) - il / (il + ir)).abs() < 1e-4,
+            "unlearnt: the tree's split"
+        );
+        let got = mass(&after);
+        assert!(
+            (got - expected).abs() < 1e-4,
+            "left subtree {got} vs {expected}"
+        );
+        checked += 1;
+    }
+    assert!(checked >= 3, "only {checked} points checked");
+}
+
+fn descent(scene: &Scene) -> LearnedStrategy<DescentSelection> {
+    LearnedStrategy {
+        name: "learned-descent+bsdf".into(),
+        selection: DescentSelection::new(scene, PowerUnits::Watts, LearnedConfig::default())
+            .unwrap(),
+        with_bsdf: true,
+        light_samples: 1,
+    }
 }
 
 /// What was learnt moves the probabilities: at a learnt point the clusters the tallies found

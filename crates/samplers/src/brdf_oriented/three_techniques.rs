@@ -109,7 +109,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
                 LsState::Learned(sel, st) => {
                     let u = rng.next_2d();
                     let memory = &mut ctx.pixel_memory[LEARNED_SLOT..];
-                    sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, sel, st)
+                    sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, *sel, st)
                         .map(|(s, p, f)| (s, p, f, None))
                 }
                 LsState::Tree(..) => sample_pick(scene, sp, light, pmf, rng, ctx.counters)

@@ -7,18 +7,46 @@
 //! * `regions.rs`: the hash grid of regions (position cell × normal bucket), the per-region
 //!   tallies, and the observation a sample leaves in its pixel's memory;
 //! * `selection.rs`: the per-point cluster probabilities, `pick` beside `pmf`;
-//! * `strategy.rs`: `learned` and `learned+bsdf`, which merge the pass's observations in
-//!   pixel order between passes (`DirectLighting::end_pass`).
+//! * `descent.rs`: the learned descent, a factor learnt per region for every node of the
+//!   tree's top levels, applied at each step of the descent (`learned-descent`);
+//! * `strategy.rs`: `learned`, `learned+bsdf` and the descent's strategies, which merge the
+//!   pass's observations in pixel order between passes (`DirectLighting::end_pass`).
 //!
 //! Unbiased: a sample's probabilities are functions of the shading point and of statistics
 //! frozen before its pass began, so each pass is an unbiased estimate (as the per-pass N_max of
 //! `mis3-adaptive`). The same for any thread count: a pass's observations are merged in pixel
 //! order.
+pub mod descent;
 pub mod regions;
 pub mod selection;
 pub mod strategy;
 
+use crate::selection::LightSelection;
+use render_core::estimator::PIXEL_MEMORY;
 use serde::{Deserialize, Serialize};
+
+/// A selection that learns between passes from the light samples it is shown.
+pub trait Learner: LightSelection {
+    /// Leaves in `memory` (the pixel's) what the light sample of `light` taught at the point
+    /// of `state`: the luminance `lum_f` of its unshadowed f·L, the density `p` it was drawn
+    /// with (pmf × point density) and whether its shadow ray reached the light.
+    fn observe(
+        &self,
+        state: &Self::State,
+        light: u32,
+        lum_f: f32,
+        p: f32,
+        hit: bool,
+        memory: &mut [f32],
+    );
+    /// Forgets everything learnt (a new render).
+    fn forget(&self);
+    /// Merges the observations the pass just finished left in the pixels' memory, in pixel
+    /// order.
+    fn merge(&self, pixels: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>);
+    /// Its parameters and what it holds, for the render's JSON.
+    fn describe(&self) -> serde_json::Value;
+}
 
 /// What a region learns of each cluster, the factor that multiplies its prior at a point.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]

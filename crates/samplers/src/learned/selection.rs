@@ -4,10 +4,11 @@
 //! inside the cluster. `pick` and `pmf` read the same per-point probabilities, so a light's
 //! probability at sampling and at any replay is the same number.
 use super::regions::{RegionGrid, RegionTable};
-use super::{LearnTarget, LearnedConfig};
+use super::{LearnTarget, LearnedConfig, Learner};
 use crate::selection::LightSelection;
 use crate::tree_selection::{PowerUnits, TreeMode, TreeSelection, TreeState};
 use light_tree::{Cut, LightTree, Rescaled};
+use render_core::estimator::PIXEL_MEMORY;
 use render_core::estimator::ShadingPoint;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
@@ -43,24 +44,7 @@ impl LearnedSelection {
                 config.clusters
             ));
         }
-        if !(config.defensive > 0.0 && config.defensive <= 1.0) || !(config.prior_strength > 0.0) {
-            return Err(format!(
-                "learned selection: need defensive share in (0, 1] and prior strength > 0, got {} and {}",
-                config.defensive, config.prior_strength
-            ));
-        }
-        if !(1..=1024).contains(&config.light_samples) {
-            return Err(format!(
-                "learned selection: light samples per point must be in 1..=1024, got {}",
-                config.light_samples
-            ));
-        }
-        if !(config.cells_per_diagonal >= 1.0 && config.cells_per_diagonal <= 1e5) {
-            return Err(format!(
-                "learned selection: cells per scene diagonal must be in [1, 100000], got {}",
-                config.cells_per_diagonal
-            ));
-        }
+        check_config(&config)?;
         let tree = TreeSelection::new(scene, TreeMode::Single, units)?;
         // Breadth-first: clusters of about equal depth, which the SAOH build keeps compact
         // in space (a room's lights, a lamp's bulbs), the unit visibility is learnt for.
@@ -82,6 +66,30 @@ impl LearnedSelection {
     fn light_tree(&self) -> Option<&LightTree> {
         self.tree.tree.as_ref()
     }
+}
+
+/// Refuses parameters no learned selection can use (the defensive share, the prior strength,
+/// the light samples per point, the cell size).
+pub(crate) fn check_config(config: &LearnedConfig) -> Result<(), String> {
+    if !(config.defensive > 0.0 && config.defensive <= 1.0) || !(config.prior_strength > 0.0) {
+        return Err(format!(
+            "learned selection: need defensive share in (0, 1] and prior strength > 0, got {} and {}",
+            config.defensive, config.prior_strength
+        ));
+    }
+    if !(1..=1024).contains(&config.light_samples) {
+        return Err(format!(
+            "learned selection: light samples per point must be in 1..=1024, got {}",
+            config.light_samples
+        ));
+    }
+    if !(config.cells_per_diagonal >= 1.0 && config.cells_per_diagonal <= 1e5) {
+        return Err(format!(
+            "learned selection: cells per scene diagonal must be in [1, 100000], got {}",
+            config.cells_per_diagonal
+        ));
+    }
+    Ok(())
 }
 
 /// One shading point: its region, the memoised importances and the cluster probabilities.
@@ -271,7 +279,7 @@ impl LightSelection for LearnedSelection {
 /// pixel's memory from `memory[0]` on for the merge after the pass: `(sample, pmf × point pdf,
 /// f·L)` when the light is visible, `None` otherwise. `u`: the point's random numbers.
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn sample_observed(
+pub(crate) fn sample_observed<L: Learner>(
     scene: &Scene,
     sp: &ShadingPoint,
     light: u32,
@@ -279,8 +287,8 @@ pub(crate) fn sample_observed(
     u: glam::Vec2,
     counters: &mut render_core::stats::Counters,
     memory: &mut [f32],
-    sel: &LearnedSelection,
-    state: &LearnedState,
+    sel: &L,
+    state: &L::State,
 ) -> Option<(render_core::light::LightSample, f32, render_core::Vec3)> {
     let s = scene.sample_light(light, sp.point(), u)?;
     let p = pmf * s.pdf;
@@ -294,12 +302,35 @@ pub(crate) fn sample_observed(
     counters.shadow_rays += 1;
     let o = sp.origin_towards(s.wi);
     let hit = !scene.occluded(o, s.wi, (s.point - o).length());
-    if let Some(cluster) = sel.cluster_of(light) {
+    sel.observe(
+        state,
+        light,
+        render_core::colour::luminance(f),
+        p,
+        hit,
+        memory,
+    );
+    hit.then_some((s, p, f))
+}
+
+impl Learner for LearnedSelection {
+    fn observe(
+        &self,
+        state: &LearnedState,
+        light: u32,
+        lum_f: f32,
+        p: f32,
+        hit: bool,
+        memory: &mut [f32],
+    ) {
+        let Some(cluster) = self.cluster_of(light) else {
+            return;
+        };
         // The contribution f/p of the light within its cluster, over the cluster's prior.
         let pc = state.cluster_pmf(cluster);
         let prior = state.prior[cluster];
         let ratio = if hit && pc > 0.0 && prior > 0.0 {
-            let y = render_core::colour::luminance(f) * pc / p;
+            let y = lum_f * pc / p;
             sanitize(y / prior)
         } else {
             0.0
@@ -312,5 +343,31 @@ pub(crate) fn sample_observed(
         }
         .write(memory, state.stamp);
     }
-    hit.then_some((s, p, f))
+
+    fn forget(&self) {
+        self.table
+            .write()
+            .unwrap_or_else(|e| e.into_inner())
+            .clear();
+    }
+
+    fn merge(&self, pixels: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+        self.table
+            .write()
+            .unwrap_or_else(|e| e.into_inner())
+            .merge_pass(pixels, 0);
+    }
+
+    fn describe(&self) -> serde_json::Value {
+        let t = self.table.read().unwrap_or_else(|e| e.into_inner());
+        serde_json::json!({
+            "config": self.config,
+            "clusters": self.cut.len(),
+            "cell_size": self.grid.cell,
+            "regions": t.len(),
+            "region_memory_bytes": t.memory_bytes(),
+            "dropped_observations": t.dropped,
+            "passes_learnt": t.pass,
+        })
+    }
 }

@@ -1,48 +1,38 @@
-//! Strategies `learned` and `learned+bsdf`: N lights by the learned cluster selection (one by
-//! default; ± one BSDF sample, power heuristic with counts), the first light sample leaving
-//! its observation in the pixel's memory for the merge between passes.
-use super::regions::{Observation, SLOTS};
+//! Strategies `learned`, `learned+bsdf`, `learned-descent` and `learned-descent+bsdf`: N lights
+//! by a learned selection (one by default; ± one BSDF sample, power heuristic with counts), the
+//! first light sample leaving its observation in the pixel's memory for the merge between
+//! passes.
+use super::Learner;
+use super::regions::Observation;
 use super::selection::{LearnedSelection, sample_observed};
 use crate::bsdf_sampling::sample_bsdf;
 use crate::light_strategy::{Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
 use crate::mis::power_heuristic;
 use crate::scratch::Pooled;
-use crate::selection::LightSelection;
 use render_core::Vec3;
 use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 
-/// The learned selection as a strategy.
-pub struct LearnedStrategy {
-    /// `learned` or `learned+bsdf`.
+/// A learned selection as a strategy.
+pub struct LearnedStrategy<S = LearnedSelection> {
+    /// `learned`, `learned+bsdf`, `learned-descent` or `learned-descent+bsdf`.
     pub name: String,
     /// The selection and its statistics.
-    pub selection: LearnedSelection,
+    pub selection: S,
     /// Add one BSDF sample, combined by the power heuristic.
     pub with_bsdf: bool,
+    /// Light samples per shading point (at least 1).
+    pub light_samples: u32,
 }
 
-impl DirectLighting for LearnedStrategy {
+impl<S: Learner> DirectLighting for LearnedStrategy<S> {
     fn name(&self) -> String {
         self.name.clone()
     }
 
     fn parameters(&self) -> serde_json::Value {
-        let t = self
-            .selection
-            .table
-            .read()
-            .unwrap_or_else(|e| e.into_inner());
-        serde_json::json!({
-            "config": self.selection.config,
-            "clusters": self.selection.cut.len(),
-            "cell_size": self.selection.grid.cell,
-            "regions": t.len(),
-            "region_memory_bytes": t.memory_bytes(),
-            "dropped_observations": t.dropped,
-            "passes_learnt": t.pass,
-        })
+        self.selection.describe()
     }
 
     fn techniques(&self) -> Vec<&'static str> {
@@ -61,20 +51,16 @@ impl DirectLighting for LearnedStrategy {
         ctx: &mut SampleContext,
     ) -> Vec3 {
         let sel = &self.selection;
-        let state = {
-            let table = sel.table.read().unwrap_or_else(|e| e.into_inner());
-            sel.prepare_with(scene, sp, &table)
-        };
+        let state = sel.prepare(scene, sp);
         Observation::clear(&mut ctx.pixel_memory[..]);
         ctx.counters
             .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
         let mut picks = Pooled::<Picks>::take();
         let x = sp.point();
         let mut l = Vec3::ZERO;
-        // At least 1: `LearnedSelection::new` refuses 0.
-        let n = sel.config.light_samples;
+        let n = self.light_samples.max(1);
         // Where the second and later samples' observations go (one is learnt per pass).
-        let mut unlearnt = [0.0f32; SLOTS];
+        let mut unlearnt = [0.0f32; PIXEL_MEMORY];
         for i in 0..n {
             picks.0.clear();
             sel.pick(&state, sp, rng, &mut picks.0);
@@ -116,18 +102,10 @@ impl DirectLighting for LearnedStrategy {
     }
 
     fn begin_render(&self) {
-        self.selection
-            .table
-            .write()
-            .unwrap_or_else(|e| e.into_inner())
-            .clear();
+        self.selection.forget();
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
-        self.selection
-            .table
-            .write()
-            .unwrap_or_else(|e| e.into_inner())
-            .merge_pass(pixel_memory, 0);
+        self.selection.merge(pixel_memory);
     }
 }

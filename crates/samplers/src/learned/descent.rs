@@ -1,0 +1,499 @@
+//! The learned descent: per region, a factor learnt for every node of the light tree's top
+//! [`LEVELS`] levels, which multiplies the node's unshadowed importance at each step of the
+//! descent (after Pantaleoni 2019, *Importance sampling of many lights with reinforcement
+//! lightcuts learning*, and in the role of Vévoda et al. 2018's per-region cut). The cluster
+//! selection learns one level (its cut); this one learns down to clusters of a few lights, so
+//! it also corrects the tree's bounds inside what the cluster selection treats as one unit.
+//!
+//! What is learnt: a sample of light l, drawn with probability P(l) through node n (reached
+//! with probability P(n)), estimates n's shadowed contribution T_n at the point as
+//! Y · P(n), Y = lum(f·L·V)/(P(l) p_point); its ratio to n's importance I_n,
+//! ρ_n = Y · P(n)/I_n, has mean T_n/I_n given that the sample went through n. A region's
+//! factor of n is ρ̄_n shrunk towards its parent's, r̂_n = (Σρ_n + a·r̂_parent)/(rays_n + a),
+//! the root's the mean of its ratios (1 before any), so a node not yet observed keeps its
+//! parent's factor and the tree's own split below it.
+//!
+//! Sampling: with probability 1 − α the descent goes left ∝ I_left·r̂_left against
+//! I_right·r̂_right, otherwise ∝ the importances alone (the tree's descent); the pmf of a light
+//! is (1 − α)·Q(l) + α·T(l), both products replayed along its trail with the same operations,
+//! so every light the tree reaches keeps at least α times its tree probability.
+use super::regions::{KeyHasher, RegionGrid};
+use super::{LearnedConfig, Learner};
+use crate::selection::LightSelection;
+use crate::tree_selection::{PowerUnits, TreeMode, TreeSelection};
+use light_tree::{DescentRandom, LightTree, Rescaled};
+use render_core::Vec3;
+use render_core::estimator::{PIXEL_MEMORY, ShadingPoint};
+use render_core::rng::SampleStream;
+use render_core::scene::Scene;
+use std::cell::Cell;
+use std::collections::HashMap;
+use std::hash::BuildHasherDefault;
+use std::sync::{Arc, RwLock};
+
+/// Tree levels learnt (depths 1 to `LEVELS`): an observation keeps one ratio per level beside
+/// its stamp, region key and light, in the pixel's sixteen floats.
+pub const LEVELS: usize = PIXEL_MEMORY - 5;
+/// Most bytes the tallies of all regions may take (the region cap is lowered to
+/// fit).
+const MAX_TABLE_BYTES: usize = 256 << 20;
+/// Most lights an observation can name (a light index is stored exactly in an f32).
+const MAX_LIGHTS: usize = 1 << 24;
+
+/// What one region learnt of one node: the sum of the ratios observed through it and their
+/// number (misses included, with ratio 0).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct NodeTally {
+    /// Σ ρ_n.
+    pub ratio_sum: f32,
+    /// Samples that went through the node.
+    pub rays: u32,
+}
+
+/// Region key → per learnt pair of siblings (the children of an interior node above depth
+/// `LEVELS`) their tallies side by side, which is all a step of the descent reads.
+#[derive(Clone)]
+pub struct DescentTable {
+    index: HashMap<u64, u32, BuildHasherDefault<KeyHasher>>,
+    tallies: Vec<[NodeTally; 2]>,
+    pairs: usize,
+    max_regions: usize,
+    /// Complete passes merged so far (the stamp of the pass now running is `pass + 1`).
+    pub pass: u32,
+    /// Observations dropped because the table was full.
+    pub dropped: u64,
+}
+
+impl DescentTable {
+    fn new(pairs: usize, max_regions: usize) -> DescentTable {
+        DescentTable {
+            index: HashMap::default(),
+            tallies: Vec::new(),
+            pairs,
+            max_regions,
+            pass: 0,
+            dropped: 0,
+        }
+    }
+
+    /// The tallies of region `key`, if it has been seen: per learnt pair, left and right.
+    pub fn region(&self, key: u64) -> Option<&[[NodeTally; 2]]> {
+        let i = *self.index.get(&key)? as usize * self.pairs;
+        Some(&self.tallies[i..i + self.pairs])
+    }
+
+    /// Regions stored.
+    pub fn len(&self) -> usize {
+        self.index.len()
+    }
+
+    /// Whether no region is stored.
+    pub fn is_empty(&self) -> bool {
+        self.index.is_empty()
+    }
+
+    /// Bytes of the tallies, the factors and the map's entries at their capacity.
+    pub fn memory_bytes(&self) -> usize {
+        self.tallies.capacity() * std::mem::size_of::<[NodeTally; 2]>()
+            + self.index.capacity() * (std::mem::size_of::<(u64, u32)>() + 1)
+    }
+
+    /// The index of region `key`, added if new and there is room.
+    fn region_index(&mut self, key: u64) -> Option<usize> {
+        match self.index.get(&key) {
+            Some(&i) => Some(i as usize),
+            None if self.index.len() < self.max_regions => {
+                let i = self.index.len();
+                self.index.insert(key, i as u32);
+                let k = self.pairs;
+                self.tallies
+                    .resize(self.tallies.len() + k, [NodeTally::default(); 2]);
+                Some(i)
+            }
+            None => None,
+        }
+    }
+}
+
+/// The learned descent over the scene's light tree.
+pub struct DescentSelection {
+    /// The light tree (single descent) and the receiver convention.
+    pub tree: TreeSelection,
+    /// Per node: the index of the learnt pair of its children, `u32::MAX` for leaves and nodes
+    /// at depth `LEVELS` or more.
+    pair_of: Vec<u32>,
+    /// Shading point → region.
+    pub grid: RegionGrid,
+    /// Its parameters (`clusters` and `target` are the cluster selection's and unused here).
+    pub config: LearnedConfig,
+    /// What earlier passes taught, frozen during a pass (shared with the points of a pass).
+    pub table: RwLock<Arc<DescentTable>>,
+}
+
+impl DescentSelection {
+    /// The learned descent for `scene` (tree in `units` of power).
+    pub fn new(
+        scene: &Scene,
+        units: PowerUnits,
+        config: LearnedConfig,
+    ) -> Result<DescentSelection, String> {
+        super::selection::check_config(&config)?;
+        if scene.lights.len() > MAX_LIGHTS {
+            return Err(format!(
+                "learned descent: at most {MAX_LIGHTS} lights, the scene has {}",
+                scene.lights.len()
+            ));
+        }
+        let tree = TreeSelection::new(scene, TreeMode::Single, units)?;
+        let (pair_of, pair_count) = tree.tree.as_ref().map_or_else(Default::default, pairs);
+        let per_region = pair_count.max(1) * std::mem::size_of::<[NodeTally; 2]>();
+        let max_regions = config.max_regions.min(MAX_TABLE_BYTES / per_region).max(1);
+        let (lo, _) = scene.bounds;
+        Ok(DescentSelection {
+            tree,
+            table: RwLock::new(Arc::new(DescentTable::new(pair_count, max_regions))),
+            pair_of,
+            grid: RegionGrid::new(lo, scene.diagonal(), config.cells_per_diagonal),
+            config,
+        })
+    }
+
+    fn light_tree(&self) -> Option<&LightTree> {
+        self.tree.tree.as_ref()
+    }
+}
+
+/// The root's factor in a region: the mean ratio its children's observations found (1 before
+/// any).
+fn root_factor(tallies: &[[NodeTally; 2]]) -> f32 {
+    tallies.first().map_or(1.0, |[l, r]| {
+        let (sum, rays) = (l.ratio_sum + r.ratio_sum, l.rays + r.rays);
+        if rays > 0 && sum > 0.0 {
+            sum / rays as f32
+        } else {
+            1.0
+        }
+    })
+}
+
+/// The learnt pairs of `tree`: per node the index of its children's pair (interior nodes above
+/// depth `LEVELS`, in DFS order, `u32::MAX` for the others), and their number.
+fn pairs(tree: &LightTree) -> (Vec<u32>, usize) {
+    let mut count = 0usize;
+    let pair_of = tree
+        .nodes()
+        .iter()
+        .map(|node| {
+            if node.is_leaf() || node.depth() as usize >= LEVELS {
+                u32::MAX
+            } else {
+                count += 1;
+                (count - 1) as u32
+            }
+        })
+        .collect();
+    (pair_of, count)
+}
+
+/// One shading point: its region and receiver, and the ratios' per-level scales of the last
+/// pick (for its observation).
+pub struct DescentState {
+    table: Arc<DescentTable>,
+    /// The first of the region's pairs in the table, if the region has been seen.
+    region: Option<usize>,
+    /// The region of the shading point.
+    pub key: u64,
+    /// The stamp of the pass being drawn.
+    pub stamp: u32,
+    x: Vec3,
+    n: Vec3,
+    /// The last pick's light and, per level of its path below the root, P(n)/I_n (0 past
+    /// its leaf).
+    last: Cell<(u32, [f32; LEVELS])>,
+}
+
+impl DescentState {
+    /// Whether the point's region has been seen in earlier passes.
+    pub fn learnt(&self) -> bool {
+        self.region.is_some()
+    }
+}
+
+/// How a walk down the tree chooses: by random numbers, or along a light's trail.
+enum Steer<'a> {
+    Draw { learned: bool, u: &'a mut Rescaled },
+    Trail(u64),
+}
+
+/// What a walk found: the light, its pmf, and per level P(n)/I_n.
+struct Walk {
+    light: usize,
+    pmf: f32,
+    scales: [f32; LEVELS],
+}
+
+impl DescentSelection {
+    /// Walks from the root to a leaf, multiplying both products (learned and tree) with the
+    /// same operations whichever way it is steered, so that sampling and replay agree bit for
+    /// bit. `None` at a dead end (both children of zero importance).
+    fn walk(&self, lt: &LightTree, state: &DescentState, mut steer: Steer) -> Option<Walk> {
+        let tallies = state
+            .region
+            .map(|i| &state.table.tallies[i..i + state.table.pairs]);
+        let alpha = self.config.defensive;
+        let a = self.config.prior_strength;
+        let (x, n) = (state.x, state.n);
+        let mut id = lt.root();
+        let mut factor = tallies.map_or(1.0, root_factor);
+        let (mut q, mut t) = (1.0f32, 1.0f32);
+        let mut scales = [0.0f32; LEVELS];
+        let mut depth = 0usize;
+        loop {
+            let node = lt.node(id);
+            let Some((l, r)) = node.children(id) else {
+                let light = node.light()?;
+                let pmf = (1.0 - alpha) * q + alpha * t;
+                return Some(Walk { light, pmf, scales });
+            };
+            // The next step reads one of the children's tallies: both are fetched while this
+            // step's importances are evaluated.
+            if let Some(t) = tallies {
+                for c in [l, r] {
+                    if let Some(next) = t.get(self.pair_of[c as usize] as usize) {
+                        prefetch(next);
+                    }
+                }
+            }
+            let [fl, fr] = match (tallies, self.pair_of[id as usize]) {
+                (Some(t), p) if p != u32::MAX => {
+                    t[p as usize].map(|t| (t.ratio_sum + a * factor) / (t.rays as f32 + a))
+                }
+                _ => [factor; 2],
+            };
+            let [il, ir] = lt.child_importances(id, x, n)?.map(sanitize);
+            let sum_t = il + ir;
+            if sum_t == 0.0 {
+                return None;
+            }
+            let (wl, wr) = (il * fl, ir * fr);
+            let sum_q = wl + wr;
+            let (ql, qr) = if sum_q > 0.0 {
+                (wl / sum_q, wr / sum_q)
+            } else {
+                (il / sum_t, ir / sum_t)
+            };
+            let (tl, tr) = (il / sum_t, ir / sum_t);
+            let left = match &mut steer {
+                Steer::Trail(bits) => {
+                    let left = *bits & 1 == 0;
+                    *bits >>= 1;
+                    left
+                }
+                Steer::Draw { learned, u } => {
+                    let pl = if *learned { ql } else { tl };
+                    if pl >= 1.0 {
+                        true
+                    } else if pl <= 0.0 {
+                        false
+                    } else {
+                        u.go_left(pl)
+                    }
+                }
+            };
+            let (child, qc, tc, fc, ic) = if left {
+                (l, ql, tl, fl, il)
+            } else {
+                (r, qr, tr, fr, ir)
+            };
+            q *= qc;
+            t *= tc;
+            id = child;
+            factor = fc;
+            if depth < LEVELS && ic > 0.0 {
+                scales[depth] = ((1.0 - alpha) * q + alpha * t) / ic;
+            }
+            depth += 1;
+        }
+    }
+}
+
+/// Writes into a pixel's `memory` the observation of pass `stamp` that the merge after it
+/// reads: the region `key`, the `light` sampled and the ratio ρ of each node on its path below
+/// the root, from depth 1 on (0 past its leaf).
+pub fn write_observation(
+    memory: &mut [f32],
+    stamp: u32,
+    key: u64,
+    light: u32,
+    ratios: &[f32; LEVELS],
+) {
+    let mask = (1u64 << 21) - 1;
+    memory[0] = stamp as f32;
+    for j in 0..3 {
+        memory[1 + j] = ((key >> (21 * j as u32)) & mask) as f32;
+    }
+    memory[4] = light as f32;
+    memory[5..5 + LEVELS].copy_from_slice(ratios);
+}
+
+/// A hint to bring `x`'s cache line in (nothing off x86-64).
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch never faults, and the pointer comes from a reference.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(x as *const T as *const i8);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
+#[inline]
+fn sanitize(x: f32) -> f32 {
+    if x.is_finite() && x > 0.0 { x } else { 0.0 }
+}
+
+impl LightSelection for DescentSelection {
+    type State = DescentState;
+
+    fn prepare(&self, scene: &Scene, sp: &ShadingPoint) -> DescentState {
+        let (x, n) = self.tree.prepare(scene, sp).receiver();
+        let key = self.grid.key(sp.point(), sp.bsdf.ng);
+        let table = Arc::clone(&self.table.read().unwrap_or_else(|e| e.into_inner()));
+        let region = table.index.get(&key).map(|&i| i as usize * table.pairs);
+        DescentState {
+            stamp: table.pass + 1,
+            table,
+            region,
+            key,
+            x,
+            n,
+            last: Cell::new((u32::MAX, [0.0; LEVELS])),
+        }
+    }
+
+    fn pick(
+        &self,
+        state: &DescentState,
+        _: &ShadingPoint,
+        rng: &mut SampleStream,
+        picks: &mut Vec<(u32, f32)>,
+    ) {
+        let Some(lt) = self.light_tree() else { return };
+        let learned = ((rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64))
+            >= self.config.defensive as f64;
+        let mut u = Rescaled(rng.next_u64());
+        if let Some(w) = self.walk(lt, state, Steer::Draw { learned, u: &mut u })
+            && w.pmf > 0.0
+        {
+            state.last.set((w.light as u32, w.scales));
+            picks.push((w.light as u32, w.pmf));
+        }
+    }
+
+    fn pmf(&self, state: &DescentState, _: &ShadingPoint, light: u32) -> f32 {
+        let Some(lt) = self.light_tree() else {
+            return 0.0;
+        };
+        if light as usize >= lt.num_lights() {
+            return 0.0;
+        }
+        let trail = lt.bit_trail(light as usize);
+        match self.walk(lt, state, Steer::Trail(trail)) {
+            Some(w) if w.light == light as usize => w.pmf,
+            _ => 0.0,
+        }
+    }
+}
+
+impl Learner for DescentSelection {
+    fn observe(
+        &self,
+        state: &DescentState,
+        light: u32,
+        lum_f: f32,
+        p: f32,
+        hit: bool,
+        memory: &mut [f32],
+    ) {
+        let (last, scales) = state.last.get();
+        if last != light {
+            return;
+        }
+        let y = if hit && p > 0.0 {
+            sanitize(lum_f / p)
+        } else {
+            0.0
+        };
+        write_observation(
+            memory,
+            state.stamp,
+            state.key,
+            light,
+            &scales.map(|s| sanitize(y * s)),
+        );
+    }
+
+    fn forget(&self) {
+        let mut guard = self.table.write().unwrap_or_else(|e| e.into_inner());
+        let (pairs, max_regions) = (guard.pairs, guard.max_regions);
+        *guard = Arc::new(DescentTable::new(pairs, max_regions));
+    }
+
+    fn merge(&self, pixels: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
+        let mut guard = self.table.write().unwrap_or_else(|e| e.into_inner());
+        let table = Arc::make_mut(&mut guard);
+        let stamp = table.pass + 1;
+        if let Some(lt) = self.light_tree() {
+            for m in pixels {
+                if m[0] != stamp as f32 {
+                    continue;
+                }
+                let key = (0..3).fold(0u64, |k, j| k | ((m[1 + j] as u64) << (21 * j as u32)));
+                let light = m[4] as usize;
+                if light >= lt.num_lights() {
+                    continue;
+                }
+                let Some(i) = table.region_index(key) else {
+                    table.dropped += 1;
+                    continue;
+                };
+                let base = i * table.pairs;
+                let mut trail = lt.bit_trail(light);
+                let mut id = lt.root();
+                for &rho in &m[5..5 + LEVELS] {
+                    let p = self.pair_of[id as usize];
+                    let Some((l, r)) = lt.node(id).children(id) else {
+                        break;
+                    };
+                    if p == u32::MAX {
+                        break;
+                    }
+                    let side = (trail & 1) as usize;
+                    let t = &mut table.tallies[base + p as usize][side];
+                    t.ratio_sum += rho;
+                    t.rays += 1;
+                    id = if side == 0 { l } else { r };
+                    trail >>= 1;
+                }
+            }
+        }
+        table.pass = stamp;
+    }
+
+    fn describe(&self) -> serde_json::Value {
+        let t = self.table.read().unwrap_or_else(|e| e.into_inner());
+        serde_json::json!({
+            "config": self.config,
+            "levels": LEVELS,
+            "learnt_pairs": t.pairs,
+            "cell_size": self.grid.cell,
+            "regions": t.len(),
+            "max_regions": t.max_regions,
+            "region_memory_bytes": t.memory_bytes(),
+            "dropped_observations": t.dropped,
+            "passes_learnt": t.pass,
+        })
+    }
+}
