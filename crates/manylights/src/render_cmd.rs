@@ -217,6 +217,10 @@ pub struct MethodArgs {
     /// `learned`, `learned+bsdf`: light samples per shading point (beside one BSDF sample).
     #[arg(long, default_value_t = LearnedConfig::default().light_samples)]
     pub learned_samples: u32,
+    /// Learned selection: the prior's strength a, in rays (what a cluster or node not yet
+    /// observed in a region keeps, and how fast its observations take over).
+    #[arg(long, default_value_t = LearnedConfig::default().prior_strength)]
+    pub learned_prior: f32,
 }
 
 /// `--learned-target`: the names of [`LearnTarget`], listed in `--help`.
@@ -322,6 +326,7 @@ impl MethodArgs {
                 cells_per_diagonal: self.learned_cells,
                 defensive: self.learned_defensive,
                 light_samples: self.learned_samples,
+                prior_strength: self.learned_prior,
                 ..LearnedConfig::default()
             },
         }

@@ -131,7 +131,8 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
         }),
         "learned-descent" | "learned-descent+bsdf" => json!({
             "power_units": units(opts),
-            "levels": crate::learned::descent::LEVELS,
+            "max_levels": crate::learned::descent_table::LEVELS,
+            "max_pairs_per_region": crate::learned::descent_table::MAX_PAIRS,
             "learned": opts.learned,
         }),
         "oracle" | "oracle-shadowed" => {

@@ -12,6 +12,7 @@ use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use samplers::convergence::compare;
 use samplers::learned::descent::DescentSelection;
+use samplers::learned::descent_table::{DescentObservation, LEVELS};
 use samplers::learned::selection::LearnedSelection;
 use samplers::learned::strategy::LearnedStrategy;
 use samplers::learned::{LearnTarget, LearnedConfig};
@@ -180,20 +181,41 @@ fn picks_match_pmf<S: LightSelection>(
     );
 }
 
-/// The learned descent, likewise, after 6 passes of learning.
+/// The learned descent, likewise, after 6 passes of learning: on `rooms` with 400 lights (a
+/// tree learnt to its leaves) and with 6,000 (more than `MAX_PAIRS` pairs: the levels below
+/// the learnt ones take the tree's eight-wide descent).
 #[test]
 fn learned_descent_picks_follow_their_pmf_within_a_pass_and_replay_it() {
-    let scene = rooms();
-    let s = descent(&scene);
-    render(&scene, &s, &settings(&scene, (48, 32), 6, 2), &|_, _| {}).unwrap();
+    let deep = scene_formats::load_scene("builtin:rooms?lights=6000", None).unwrap();
+    for scene in [&rooms(), &deep] {
+        descent_picks_follow_their_pmf(scene);
+    }
+    assert!(descent(&deep).selection.learnt_depth() < deep_tree_depth(&deep));
+}
+
+fn deep_tree_depth(scene: &Scene) -> u32 {
+    descent(scene)
+        .selection
+        .tree
+        .tree
+        .as_ref()
+        .unwrap()
+        .max_depth()
+}
+
+fn descent_picks_follow_their_pmf(scene: &Scene) {
+    let s = descent(scene);
+    render(scene, &s, &settings(scene, (48, 32), 6, 2), &|_, _| {}).unwrap();
     assert_eq!(s.parameters()["passes_learnt"], 6);
     assert!(s.parameters()["regions"].as_u64().unwrap() > 0);
     let tree = s.selection.tree.tree.as_ref().unwrap();
     let mut learnt_points = 0;
-    for (i, sp) in camera_points(&scene).iter().enumerate() {
-        let state = s.selection.prepare(&scene, sp);
+    let depth = s.selection.learnt_depth();
+    assert!(depth > 0 && depth <= tree.max_depth());
+    for (i, sp) in camera_points(scene).iter().enumerate() {
+        let state = s.selection.prepare(scene, sp);
         learnt_points += state.learnt() as usize;
-        picks_match_pmf(&scene, &s.selection, &state, sp, i, tree);
+        picks_match_pmf(scene, &s.selection, &state, sp, i, tree);
     }
     assert!(
         learnt_points >= 3,
@@ -227,10 +249,13 @@ fn learned_descent_splits_by_the_observed_ratios() {
             let ratio = if light == a_light { 4.0 } else { 0.0 };
             for _ in 0..10 {
                 let mut m = [0.0f32; render_core::estimator::PIXEL_MEMORY];
-                let ratios = [ratio; samplers::learned::descent::LEVELS];
-                samplers::learned::descent::write_observation(
-                    &mut m, 1, before.key, light, &ratios,
-                );
+                DescentObservation {
+                    key: before.key,
+                    light,
+                    y: ratio,
+                    scales: [1.0; LEVELS],
+                }
+                .write(&mut m, 1);
                 pixels.push(m);
             }
         }

@@ -1,5 +1,5 @@
 //! The learned descent: per region, a factor learnt for every node of the light tree's top
-//! [`LEVELS`] levels, which multiplies the node's unshadowed importance at each step of the
+//! levels (all of them up to 4,096 learnt pairs and depth [`LEVELS`]), which multiplies the node's unshadowed importance at each step of the
 //! descent (after Pantaleoni 2019, *Importance sampling of many lights with reinforcement
 //! lightcuts learning*, and in the role of Vévoda et al. 2018's per-region cut). The cluster
 //! selection learns one level (its cut); this one learns down to clusters of a few lights, so
@@ -17,7 +17,10 @@
 //! I_right·r̂_right, otherwise ∝ the importances alone (the tree's descent); the pmf of a light
 //! is (1 − α)·Q(l) + α·T(l), both products replayed along its trail with the same operations,
 //! so every light the tree reaches keeps at least α times its tree probability.
-use super::regions::{KeyHasher, RegionGrid};
+use super::descent_table::{
+    DescentObservation, DescentTable, LEVELS, MAX_TABLE_BYTES, NodeTally, learnt_pairs,
+};
+use super::regions::RegionGrid;
 use super::{LearnedConfig, Learner};
 use crate::selection::LightSelection;
 use crate::tree_selection::{PowerUnits, TreeMode, TreeSelection};
@@ -27,100 +30,17 @@ use render_core::estimator::{PIXEL_MEMORY, ShadingPoint};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use std::cell::Cell;
-use std::collections::HashMap;
-use std::hash::BuildHasherDefault;
 use std::sync::{Arc, RwLock};
 
-/// Tree levels learnt (depths 1 to `LEVELS`): an observation keeps one ratio per level beside
-/// its stamp, region key and light, in the pixel's sixteen floats.
-pub const LEVELS: usize = PIXEL_MEMORY - 5;
-/// Most bytes the tallies of all regions may take (the region cap is lowered to
-/// fit).
-const MAX_TABLE_BYTES: usize = 256 << 20;
 /// Most lights an observation can name (a light index is stored exactly in an f32).
 const MAX_LIGHTS: usize = 1 << 24;
-
-/// What one region learnt of one node: the sum of the ratios observed through it and their
-/// number (misses included, with ratio 0).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct NodeTally {
-    /// Σ ρ_n.
-    pub ratio_sum: f32,
-    /// Samples that went through the node.
-    pub rays: u32,
-}
-
-/// Region key → per learnt pair of siblings (the children of an interior node above depth
-/// `LEVELS`) their tallies side by side, which is all a step of the descent reads.
-#[derive(Clone)]
-pub struct DescentTable {
-    index: HashMap<u64, u32, BuildHasherDefault<KeyHasher>>,
-    tallies: Vec<[NodeTally; 2]>,
-    pairs: usize,
-    max_regions: usize,
-    /// Complete passes merged so far (the stamp of the pass now running is `pass + 1`).
-    pub pass: u32,
-    /// Observations dropped because the table was full.
-    pub dropped: u64,
-}
-
-impl DescentTable {
-    fn new(pairs: usize, max_regions: usize) -> DescentTable {
-        DescentTable {
-            index: HashMap::default(),
-            tallies: Vec::new(),
-            pairs,
-            max_regions,
-            pass: 0,
-            dropped: 0,
-        }
-    }
-
-    /// The tallies of region `key`, if it has been seen: per learnt pair, left and right.
-    pub fn region(&self, key: u64) -> Option<&[[NodeTally; 2]]> {
-        let i = *self.index.get(&key)? as usize * self.pairs;
-        Some(&self.tallies[i..i + self.pairs])
-    }
-
-    /// Regions stored.
-    pub fn len(&self) -> usize {
-        self.index.len()
-    }
-
-    /// Whether no region is stored.
-    pub fn is_empty(&self) -> bool {
-        self.index.is_empty()
-    }
-
-    /// Bytes of the tallies, the factors and the map's entries at their capacity.
-    pub fn memory_bytes(&self) -> usize {
-        self.tallies.capacity() * std::mem::size_of::<[NodeTally; 2]>()
-            + self.index.capacity() * (std::mem::size_of::<(u64, u32)>() + 1)
-    }
-
-    /// The index of region `key`, added if new and there is room.
-    fn region_index(&mut self, key: u64) -> Option<usize> {
-        match self.index.get(&key) {
-            Some(&i) => Some(i as usize),
-            None if self.index.len() < self.max_regions => {
-                let i = self.index.len();
-                self.index.insert(key, i as u32);
-                let k = self.pairs;
-                self.tallies
-                    .resize(self.tallies.len() + k, [NodeTally::default(); 2]);
-                Some(i)
-            }
-            None => None,
-        }
-    }
-}
 
 /// The learned descent over the scene's light tree.
 pub struct DescentSelection {
     /// The light tree (single descent) and the receiver convention.
     pub tree: TreeSelection,
     /// Per node: the index of the learnt pair of its children, `u32::MAX` for leaves and nodes
-    /// at depth `LEVELS` or more.
+    /// below the learnt levels.
     pair_of: Vec<u32>,
     /// Shading point → region.
     pub grid: RegionGrid,
@@ -145,7 +65,10 @@ impl DescentSelection {
             ));
         }
         let tree = TreeSelection::new(scene, TreeMode::Single, units)?;
-        let (pair_of, pair_count) = tree.tree.as_ref().map_or_else(Default::default, pairs);
+        let (pair_of, pair_count) = tree
+            .tree
+            .as_ref()
+            .map_or_else(Default::default, learnt_pairs);
         let per_region = pair_count.max(1) * std::mem::size_of::<[NodeTally; 2]>();
         let max_regions = config.max_regions.min(MAX_TABLE_BYTES / per_region).max(1);
         let (lo, _) = scene.bounds;
@@ -161,6 +84,19 @@ impl DescentSelection {
     fn light_tree(&self) -> Option<&LightTree> {
         self.tree.tree.as_ref()
     }
+
+    /// The depth of the deepest learnt nodes (the children of the deepest learnt pairs).
+    pub fn learnt_depth(&self) -> u32 {
+        self.light_tree().map_or(0, |lt| {
+            lt.nodes()
+                .iter()
+                .zip(&self.pair_of)
+                .filter(|&(_, &p)| p != u32::MAX)
+                .map(|(n, _)| n.depth() + 1)
+                .max()
+                .unwrap_or(0)
+        })
+    }
 }
 
 /// The root's factor in a region: the mean ratio its children's observations found (1 before
@@ -174,25 +110,6 @@ fn root_factor(tallies: &[[NodeTally; 2]]) -> f32 {
             1.0
         }
     })
-}
-
-/// The learnt pairs of `tree`: per node the index of its children's pair (interior nodes above
-/// depth `LEVELS`, in DFS order, `u32::MAX` for the others), and their number.
-fn pairs(tree: &LightTree) -> (Vec<u32>, usize) {
-    let mut count = 0usize;
-    let pair_of = tree
-        .nodes()
-        .iter()
-        .map(|node| {
-            if node.is_leaf() || node.depth() as usize >= LEVELS {
-                u32::MAX
-            } else {
-                count += 1;
-                (count - 1) as u32
-            }
-        })
-        .collect();
-    (pair_of, count)
 }
 
 /// One shading point: its region and receiver, and the ratios' per-level scales of the last
@@ -222,7 +139,7 @@ impl DescentState {
 /// How a walk down the tree chooses: by random numbers, or along a light's trail.
 enum Steer<'a> {
     Draw { learned: bool, u: &'a mut Rescaled },
-    Trail(u64),
+    Trail { light: usize, bits: u64 },
 }
 
 /// What a walk found: the light, its pmf, and per level P(n)/I_n.
@@ -255,6 +172,16 @@ impl DescentSelection {
                 let pmf = (1.0 - alpha) * q + alpha * t;
                 return Some(Walk { light, pmf, scales });
             };
+            if self.pair_of[id as usize] == u32::MAX {
+                // Below the learnt levels every node inherits `factor`, so both products
+                // take the tree's own probabilities: its eight-wide descent finishes the walk.
+                let (light, sub) = match &mut steer {
+                    Steer::Draw { u, .. } => lt.sample_from(id, x, n, *u)?,
+                    Steer::Trail { light, .. } => (*light, lt.pmf_from(id, x, n, *light)),
+                };
+                let pmf = ((1.0 - alpha) * q + alpha * t) * sub;
+                return Some(Walk { light, pmf, scales });
+            }
             // The next step reads one of the children's tallies: both are fetched while this
             // step's importances are evaluated.
             if let Some(t) = tallies {
@@ -284,7 +211,7 @@ impl DescentSelection {
             };
             let (tl, tr) = (il / sum_t, ir / sum_t);
             let left = match &mut steer {
-                Steer::Trail(bits) => {
+                Steer::Trail { bits, .. } => {
                     let left = *bits & 1 == 0;
                     *bits >>= 1;
                     left
@@ -315,25 +242,6 @@ impl DescentSelection {
             depth += 1;
         }
     }
-}
-
-/// Writes into a pixel's `memory` the observation of pass `stamp` that the merge after it
-/// reads: the region `key`, the `light` sampled and the ratio ρ of each node on its path below
-/// the root, from depth 1 on (0 past its leaf).
-pub fn write_observation(
-    memory: &mut [f32],
-    stamp: u32,
-    key: u64,
-    light: u32,
-    ratios: &[f32; LEVELS],
-) {
-    let mask = (1u64 << 21) - 1;
-    memory[0] = stamp as f32;
-    for j in 0..3 {
-        memory[1 + j] = ((key >> (21 * j as u32)) & mask) as f32;
-    }
-    memory[4] = light as f32;
-    memory[5..5 + LEVELS].copy_from_slice(ratios);
 }
 
 /// A hint to bring `x`'s cache line in (nothing off x86-64).
@@ -400,7 +308,11 @@ impl LightSelection for DescentSelection {
             return 0.0;
         }
         let trail = lt.bit_trail(light as usize);
-        match self.walk(lt, state, Steer::Trail(trail)) {
+        let steer = Steer::Trail {
+            light: light as usize,
+            bits: trail,
+        };
+        match self.walk(lt, state, steer) {
             Some(w) if w.light == light as usize => w.pmf,
             _ => 0.0,
         }
@@ -426,13 +338,13 @@ impl Learner for DescentSelection {
         } else {
             0.0
         };
-        write_observation(
-            memory,
-            state.stamp,
-            state.key,
+        DescentObservation {
+            key: state.key,
             light,
-            &scales.map(|s| sanitize(y * s)),
-        );
+            y,
+            scales,
+        }
+        .write(memory, state.stamp);
     }
 
     fn forget(&self) {
@@ -447,22 +359,21 @@ impl Learner for DescentSelection {
         let stamp = table.pass + 1;
         if let Some(lt) = self.light_tree() {
             for m in pixels {
-                if m[0] != stamp as f32 {
+                let Some(o) = DescentObservation::read(m, stamp) else {
                     continue;
-                }
-                let key = (0..3).fold(0u64, |k, j| k | ((m[1 + j] as u64) << (21 * j as u32)));
-                let light = m[4] as usize;
+                };
+                let light = o.light as usize;
                 if light >= lt.num_lights() {
                     continue;
                 }
-                let Some(i) = table.region_index(key) else {
+                let Some(i) = table.region_index(o.key) else {
                     table.dropped += 1;
                     continue;
                 };
                 let base = i * table.pairs;
                 let mut trail = lt.bit_trail(light);
                 let mut id = lt.root();
-                for &rho in &m[5..5 + LEVELS] {
+                for scale in o.scales {
                     let p = self.pair_of[id as usize];
                     let Some((l, r)) = lt.node(id).children(id) else {
                         break;
@@ -472,7 +383,7 @@ impl Learner for DescentSelection {
                     }
                     let side = (trail & 1) as usize;
                     let t = &mut table.tallies[base + p as usize][side];
-                    t.ratio_sum += rho;
+                    t.ratio_sum += o.y * scale;
                     t.rays += 1;
                     id = if side == 0 { l } else { r };
                     trail >>= 1;
@@ -486,7 +397,8 @@ impl Learner for DescentSelection {
         let t = self.table.read().unwrap_or_else(|e| e.into_inner());
         serde_json::json!({
             "config": self.config,
-            "levels": LEVELS,
+            "learnt_depth": self.learnt_depth(),
+            "tree_depth": self.light_tree().map_or(0, LightTree::max_depth),
             "learnt_pairs": t.pairs,
             "cell_size": self.grid.cell,
             "regions": t.len(),

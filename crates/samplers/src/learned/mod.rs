@@ -9,6 +9,7 @@
 //! * `selection.rs`: the per-point cluster probabilities, `pick` beside `pmf`;
 //! * `descent.rs`: the learned descent, a factor learnt per region for every node of the
 //!   tree's top levels, applied at each step of the descent (`learned-descent`);
+//!   `descent_table.rs`: its per-region tallies and the observation a sample leaves;
 //! * `strategy.rs`: `learned`, `learned+bsdf` and the descent's strategies, which merge the
 //!   pass's observations in pixel order between passes (`DirectLighting::end_pass`).
 //!
@@ -17,6 +18,7 @@
 //! `mis3-adaptive`). The same for any thread count: a pass's observations are merged in pixel
 //! order.
 pub mod descent;
+pub mod descent_table;
 pub mod regions;
 pub mod selection;
 pub mod strategy;
