@@ -206,11 +206,16 @@ fn octs_hold_the_great_grandchildren() {
                 let o = c.oct_of[id as usize];
                 if node.is_leaf() || node.depth() % 3 != 0 {
                     assert_eq!(o, u32::MAX);
+                    assert_eq!(tree.oct_of(id), None);
                     continue;
                 }
                 let fast = tree.oct_lanes::<Fast8>(o, x, n);
                 let portable = tree.oct_lanes::<Portable<8>>(o, x, n);
                 assert_eq!(fast.map(f32::to_bits), portable.map(f32::to_bits));
+                // What a caller's own descent reads: the same oct and lanes.
+                assert_eq!(tree.oct_of(id), Some(o));
+                let public = tree.oct_importances(o, x, n);
+                assert_eq!(public.map(f32::to_bits), portable.map(f32::to_bits));
                 #[cfg(target_arch = "x86_64")]
                 if DescentSimd::detect() == DescentSimd::Avx2 {
                     // SAFETY: the CPU has AVX2.

@@ -559,6 +559,35 @@ impl LightTree {
         self.oct_replay(start, (x, n), &mut CachedEk { ek, cache }, light)
     }
 
+    /// The eight-wide node (oct) of `node`, for a caller's own descent over the octs: every
+    /// interior node at a depth divisible by 3 has one (`None` for the others). Its lane
+    /// `4·b₀ + 2·b₁ + b₂` holds the node reached by the branch bits b₀, b₁, b₂ below `node`
+    /// (0 = left); a leaf above that depth takes the first lane of its range, beside empty
+    /// lanes of importance 0.
+    #[inline]
+    pub fn oct_of(&self, node: NodeId) -> Option<u32> {
+        let o = *self.compact.oct_of.get(node as usize)?;
+        (o != u32::MAX).then_some(o)
+    }
+
+    /// The E&K importances of oct `oct`'s eight lanes at (x, n), unsanitised, as the tree's
+    /// own descent evaluates them (one eight-lane pass, AVX2 where the CPU has it): the same
+    /// bits on either path.
+    pub fn oct_importances(&self, oct: u32, x: Vec3, n: Vec3) -> [f32; 8] {
+        #[cfg(target_arch = "x86_64")]
+        if self.compact.simd == DescentSimd::Avx2 {
+            // SAFETY: as in `sample_from`.
+            return unsafe { self.oct_importances_avx2(oct, x, n) };
+        }
+        Ek::<Fast8>::at((x, n)).lanes(self, oct)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn oct_importances_avx2(&self, oct: u32, x: Vec3, n: Vec3) -> [f32; 8] {
+        Ek::<crate::lanes::Avx8>::at((x, n)).lanes(self, oct)
+    }
+
     /// The eight lanes of oct `oct` at (x, n) on lanes `L` (tests).
     #[cfg(test)]
     pub(crate) fn oct_lanes<L: Lanes<8>>(&self, oct: u32, x: Vec3, n: Vec3) -> [f32; 8] {

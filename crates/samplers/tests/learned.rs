@@ -223,15 +223,26 @@ fn descent_picks_follow_their_pmf(scene: &Scene) {
     );
 }
 
-/// The learned descent's factors, exactly: with light a (under the root's left child) observed
-/// at ratio 4 on every level and light b (under the right child) at 0, ten times each, the
-/// root's factor is the mean ratio 2, the children's r̂_left = (40 + 2a)/(10 + a) and
-/// r̂_right = 2a/(10 + a), and the probability of the left subtree is
-/// (1 − α)·I_l r̂_l/(I_l r̂_l + I_r r̂_r) + α·I_l/(I_l + I_r).
+/// The learned descent's factors, exactly, with prior strength a = 10: light a (under the
+/// root's left child) observed ten times at ratio 4 at depth 1 and 3 below, light b (under the
+/// right child) ten times at 0 at depth 1 and 1 below. The root's factor is the mean ratio 2,
+/// the left child's (40 + 10·2)/20 = 3 and the right's (0 + 10·2)/20 = 1, and every node below
+/// keeps its parent's (its observations equal it), so each lane of the root's eight-wide step
+/// weighs its importance times 3 on the left and 1 on the right, and the left subtree's
+/// probability is (1 − α)·3G_l/(3G_l + G_r) + α·G_l/(G_l + G_r), G the lanes' importances.
 #[test]
 fn learned_descent_splits_by_the_observed_ratios() {
     let scene = rooms();
-    let s = descent(&scene);
+    let config = LearnedConfig {
+        prior_strength: 10.0,
+        ..LearnedConfig::default()
+    };
+    let s = LearnedStrategy {
+        name: "learned-descent".into(),
+        selection: DescentSelection::new(&scene, PowerUnits::Watts, config).unwrap(),
+        with_bsdf: false,
+        light_samples: 1,
+    };
     let sel = &s.selection;
     let lt = sel.tree.tree.as_ref().unwrap();
     let n = scene.lights.len() as u32;
@@ -240,20 +251,23 @@ fn learned_descent_splits_by_the_observed_ratios() {
         (0..n).find(|&l| left(l)).unwrap(),
         (0..n).find(|&l| !left(l)).unwrap(),
     );
+    // (light, Y, scale at depth 1, scale below): every ratio Y·scale exact in the codes.
+    let observed = [(a_light, 4.0, 1.0, 0.75), (b_light, 1.0, 0.0, 1.0)];
     let mut checked = 0;
     for sp in camera_points(&scene) {
         s.begin_render();
         let before = sel.prepare(&scene, &sp);
         let mut pixels = Vec::new();
-        for light in [a_light, b_light] {
-            let ratio = if light == a_light { 4.0 } else { 0.0 };
+        for (light, y, first, below) in observed {
+            let mut scales = [below; LEVELS];
+            scales[0] = first;
             for _ in 0..10 {
                 let mut m = [0.0f32; render_core::estimator::PIXEL_MEMORY];
                 DescentObservation {
                     key: before.key,
                     light,
-                    y: ratio,
-                    scales: [1.0; LEVELS],
+                    y,
+                    scales,
                 }
                 .write(&mut m, 1);
                 pixels.push(m);
@@ -263,26 +277,26 @@ fn learned_descent_splits_by_the_observed_ratios() {
         let after = sel.prepare(&scene, &sp);
         assert!(after.learnt() && !before.learnt());
         let (x, nrm) = sel.tree.prepare(&scene, &sp).receiver();
-        let [il, ir] = lt
-            .child_importances(lt.root(), x, nrm)
-            .unwrap()
-            .map(|v| v as f64);
-        if !(il > 0.0 && ir > 0.0) {
+        let g = lt
+            .oct_importances(lt.oct_of(lt.root()).unwrap(), x, nrm)
+            .map(|v| if v > 0.0 { v as f64 } else { 0.0 });
+        let (gl, gr): (f64, f64) = (g[..4].iter().sum(), g[4..].iter().sum());
+        if !(gl > 0.0 && gr > 0.0) {
             continue;
         }
-        let a = sel.config.prior_strength as f64;
-        let (fl, fr) = ((40.0 + 2.0 * a) / (10.0 + a), 2.0 * a / (10.0 + a));
         let alpha = sel.config.defensive as f64;
-        let expected = (1.0 - alpha) * il * fl / (il * fl + ir * fr) + alpha * il / (il + ir);
+        let expected = (1.0 - alpha) * 3.0 * gl / (3.0 * gl + gr) + alpha * gl / (gl + gr);
         let mass = |st| -> f64 {
             (0..n)
                 .filter(|&l| left(l))
                 .map(|l| sel.pmf(st, &sp, l) as f64)
                 .sum()
         };
+        let unlearnt = mass(&before);
         assert!(
-            (mass(&before) - il / (il + ir)).abs() < 1e-4,
-            "unlearnt: the tree's split"
+            (unlearnt - gl / (gl + gr)).abs() < 1e-4,
+            "unlearnt: the tree's split, {unlearnt} vs {}",
+            gl / (gl + gr)
         );
         let got = mass(&after);
         assert!(

@@ -20,11 +20,12 @@
 use super::descent_table::{
     DescentObservation, DescentTable, LEVELS, MAX_TABLE_BYTES, NodeTally, learnt_pairs,
 };
+use super::descent_walk::{OctPlan, Steer, WalkInput, oct_plans, sanitize};
 use super::regions::RegionGrid;
 use super::{LearnedConfig, Learner};
 use crate::selection::LightSelection;
 use crate::tree_selection::{PowerUnits, TreeMode, TreeSelection};
-use light_tree::{DescentRandom, LightTree, Rescaled};
+use light_tree::LightTree;
 use render_core::Vec3;
 use render_core::estimator::{PIXEL_MEMORY, ShadingPoint};
 use render_core::rng::SampleStream;
@@ -42,6 +43,8 @@ pub struct DescentSelection {
     /// Per node: the index of the learnt pair of its children, `u32::MAX` for leaves and nodes
     /// below the learnt levels.
     pair_of: Vec<u32>,
+    /// Per oct of the tree: what a step of the walk reads.
+    plans: Vec<OctPlan>,
     /// Shading point → region.
     pub grid: RegionGrid,
     /// Its parameters (`clusters` and `target` are the cluster selection's and unused here).
@@ -72,7 +75,12 @@ impl DescentSelection {
         let per_region = pair_count.max(1) * std::mem::size_of::<[NodeTally; 2]>();
         let max_regions = config.max_regions.min(MAX_TABLE_BYTES / per_region).max(1);
         let (lo, _) = scene.bounds;
+        let plans = tree
+            .tree
+            .as_ref()
+            .map_or_else(Vec::new, |t| oct_plans(t, &pair_of));
         Ok(DescentSelection {
+            plans,
             tree,
             table: RwLock::new(Arc::new(DescentTable::new(pair_count, max_regions))),
             pair_of,
@@ -136,130 +144,23 @@ impl DescentState {
     }
 }
 
-/// How a walk down the tree chooses: by random numbers, or along a light's trail.
-enum Steer<'a> {
-    Draw { learned: bool, u: &'a mut Rescaled },
-    Trail { light: usize, bits: u64 },
-}
-
-/// What a walk found: the light, its pmf, and per level P(n)/I_n.
-struct Walk {
-    light: usize,
-    pmf: f32,
-    scales: [f32; LEVELS],
-}
-
 impl DescentSelection {
-    /// Walks from the root to a leaf, multiplying both products (learned and tree) with the
-    /// same operations whichever way it is steered, so that sampling and replay agree bit for
-    /// bit. `None` at a dead end (both children of zero importance).
-    fn walk(&self, lt: &LightTree, state: &DescentState, mut steer: Steer) -> Option<Walk> {
+    /// The walk's inputs at the point of `state`.
+    fn walk_input<'a>(&'a self, lt: &'a LightTree, state: &'a DescentState) -> WalkInput<'a> {
         let tallies = state
             .region
             .map(|i| &state.table.tallies[i..i + state.table.pairs]);
-        let alpha = self.config.defensive;
-        let a = self.config.prior_strength;
-        let (x, n) = (state.x, state.n);
-        let mut id = lt.root();
-        let mut factor = tallies.map_or(1.0, root_factor);
-        let (mut q, mut t) = (1.0f32, 1.0f32);
-        let mut scales = [0.0f32; LEVELS];
-        let mut depth = 0usize;
-        loop {
-            let node = lt.node(id);
-            let Some((l, r)) = node.children(id) else {
-                let light = node.light()?;
-                let pmf = (1.0 - alpha) * q + alpha * t;
-                return Some(Walk { light, pmf, scales });
-            };
-            if self.pair_of[id as usize] == u32::MAX {
-                // Below the learnt levels every node inherits `factor`, so both products
-                // take the tree's own probabilities: its eight-wide descent finishes the walk.
-                let (light, sub) = match &mut steer {
-                    Steer::Draw { u, .. } => lt.sample_from(id, x, n, *u)?,
-                    Steer::Trail { light, .. } => (*light, lt.pmf_from(id, x, n, *light)),
-                };
-                let pmf = ((1.0 - alpha) * q + alpha * t) * sub;
-                return Some(Walk { light, pmf, scales });
-            }
-            // The next step reads one of the children's tallies: both are fetched while this
-            // step's importances are evaluated.
-            if let Some(t) = tallies {
-                for c in [l, r] {
-                    if let Some(next) = t.get(self.pair_of[c as usize] as usize) {
-                        prefetch(next);
-                    }
-                }
-            }
-            let [fl, fr] = match (tallies, self.pair_of[id as usize]) {
-                (Some(t), p) if p != u32::MAX => {
-                    t[p as usize].map(|t| (t.ratio_sum + a * factor) / (t.rays as f32 + a))
-                }
-                _ => [factor; 2],
-            };
-            let [il, ir] = lt.child_importances(id, x, n)?.map(sanitize);
-            let sum_t = il + ir;
-            if sum_t == 0.0 {
-                return None;
-            }
-            let (wl, wr) = (il * fl, ir * fr);
-            let sum_q = wl + wr;
-            let (ql, qr) = if sum_q > 0.0 {
-                (wl / sum_q, wr / sum_q)
-            } else {
-                (il / sum_t, ir / sum_t)
-            };
-            let (tl, tr) = (il / sum_t, ir / sum_t);
-            let left = match &mut steer {
-                Steer::Trail { bits, .. } => {
-                    let left = *bits & 1 == 0;
-                    *bits >>= 1;
-                    left
-                }
-                Steer::Draw { learned, u } => {
-                    let pl = if *learned { ql } else { tl };
-                    if pl >= 1.0 {
-                        true
-                    } else if pl <= 0.0 {
-                        false
-                    } else {
-                        u.go_left(pl)
-                    }
-                }
-            };
-            let (child, qc, tc, fc, ic) = if left {
-                (l, ql, tl, fl, il)
-            } else {
-                (r, qr, tr, fr, ir)
-            };
-            q *= qc;
-            t *= tc;
-            id = child;
-            factor = fc;
-            if depth < LEVELS && ic > 0.0 {
-                scales[depth] = ((1.0 - alpha) * q + alpha * t) / ic;
-            }
-            depth += 1;
+        WalkInput {
+            tree: lt,
+            plans: &self.plans,
+            tallies,
+            root_factor: tallies.map_or(1.0, root_factor),
+            x: state.x,
+            n: state.n,
+            defensive: self.config.defensive,
+            prior: self.config.prior_strength,
         }
     }
-}
-
-/// A hint to bring `x`'s cache line in (nothing off x86-64).
-#[inline(always)]
-fn prefetch<T>(x: &T) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: a prefetch never faults, and the pointer comes from a reference.
-    unsafe {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        _mm_prefetch::<_MM_HINT_T0>(x as *const T as *const i8);
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
-}
-
-#[inline]
-fn sanitize(x: f32) -> f32 {
-    if x.is_finite() && x > 0.0 { x } else { 0.0 }
 }
 
 impl LightSelection for DescentSelection {
@@ -289,10 +190,10 @@ impl LightSelection for DescentSelection {
         picks: &mut Vec<(u32, f32)>,
     ) {
         let Some(lt) = self.light_tree() else { return };
-        let learned = ((rng.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64))
-            >= self.config.defensive as f64;
-        let mut u = Rescaled(rng.next_u64());
-        if let Some(w) = self.walk(lt, state, Steer::Draw { learned, u: &mut u })
+        let unit = |bits: u64| (bits >> 11) as f64 * (1.0 / (1u64 << 53) as f64);
+        let learned = unit(rng.next_u64()) >= self.config.defensive as f64;
+        let u = unit(rng.next_u64());
+        if let Some(w) = self.walk_input(lt, state).walk(Steer::Draw { learned, u })
             && w.pmf > 0.0
         {
             state.last.set((w.light as u32, w.scales));
@@ -307,12 +208,11 @@ impl LightSelection for DescentSelection {
         if light as usize >= lt.num_lights() {
             return 0.0;
         }
-        let trail = lt.bit_trail(light as usize);
         let steer = Steer::Trail {
             light: light as usize,
-            bits: trail,
+            bits: lt.bit_trail(light as usize),
         };
-        match self.walk(lt, state, steer) {
+        match self.walk_input(lt, state).walk(steer) {
             Some(w) if w.light == light as usize => w.pmf,
             _ => 0.0,
         }

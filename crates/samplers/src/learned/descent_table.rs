@@ -94,7 +94,7 @@ impl DescentTable {
 /// interior nodes above the deepest depth D ≤ [`LEVELS`] at which they number at most
 /// [`MAX_PAIRS`] (`u32::MAX` for the others), and their number.
 pub fn learnt_pairs(tree: &LightTree) -> (Vec<u32>, usize) {
-    let mut per_depth = vec![0usize; LEVELS + 1];
+    let mut per_depth = [0usize; LEVELS + 1];
     for node in tree.nodes() {
         if !node.is_leaf() && (node.depth() as usize) < LEVELS {
             per_depth[node.depth() as usize] += 1;

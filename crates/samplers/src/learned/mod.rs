@@ -10,6 +10,7 @@
 //! * `descent.rs`: the learned descent, a factor learnt per region for every node of the
 //!   tree's top levels, applied at each step of the descent (`learned-descent`);
 //!   `descent_table.rs`: its per-region tallies and the observation a sample leaves;
+//!   `descent_walk.rs`: its walk, eight lanes at a time on the tree's own eight-wide nodes;
 //! * `strategy.rs`: `learned`, `learned+bsdf` and the descent's strategies, which merge the
 //!   pass's observations in pixel order between passes (`DirectLighting::end_pass`).
 //!
@@ -19,6 +20,7 @@
 //! order.
 pub mod descent;
 pub mod descent_table;
+mod descent_walk;
 pub mod regions;
 pub mod selection;
 pub mod strategy;
