@@ -31,7 +31,7 @@ crate::scratch_pool!(Picks, |p| p.0.clear());
 
 /// Per-thread buffer of each pick's two numbers for its point on the light.
 #[derive(Default)]
-struct PickNumbers(Vec<Vec2>);
+pub(crate) struct PickNumbers(pub(crate) Vec<Vec2>);
 crate::scratch_pool!(PickNumbers, |p| p.0.clear());
 
 /// Index of light sampling in the technique counters.

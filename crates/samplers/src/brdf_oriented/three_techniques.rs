@@ -110,7 +110,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
                     let u = rng.next_2d();
                     let memory = &mut ctx.pixel_memory[LEARNED_SLOT..];
                     sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, *sel, st)
-                        .map(|(s, p, f)| (s, p, f, None))
+                        .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf)))
                 }
                 LsState::Tree(..) => sample_pick(scene, sp, light, pmf, rng, ctx.counters)
                     .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf))),

@@ -132,7 +132,7 @@ pub struct DescentState {
     pub stamp: u32,
     x: Vec3,
     n: Vec3,
-    /// The last pick's light and, per level of its path below the root, P(n)/I_n (0 past
+    /// The first pick's light and, per level of its path below the root, P(n)/I_n (0 past
     /// its leaf).
     last: Cell<(u32, [f32; LEVELS])>,
 }
@@ -196,7 +196,11 @@ impl LightSelection for DescentSelection {
         if let Some(w) = self.walk_input(lt, state).walk(Steer::Draw { learned, u })
             && w.pmf > 0.0
         {
-            state.last.set((w.light as u32, w.scales));
+            // Only a point's first light sample is learnt from (`LearnedStrategy`): its
+            // scales are kept for the observation.
+            if state.last.get().0 == u32::MAX {
+                state.last.set((w.light as u32, w.scales));
+            }
             picks.push((w.light as u32, w.pmf));
         }
     }

@@ -277,7 +277,8 @@ impl LightSelection for LearnedSelection {
 
 /// A light sample of a learned pick, shaded with its shadow ray, whose outcome is left in the
 /// pixel's memory from `memory[0]` on for the merge after the pass: `(sample, pmf × point pdf,
-/// f·L)` when the light is visible, `None` otherwise. `u`: the point's random numbers.
+/// f·L, the BSDF's density of its direction)` when the light is visible, `None` otherwise.
+/// `u`: the point's random numbers.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn sample_observed<L: Learner>(
     scene: &Scene,
@@ -289,13 +290,14 @@ pub(crate) fn sample_observed<L: Learner>(
     memory: &mut [f32],
     sel: &L,
     state: &L::State,
-) -> Option<(render_core::light::LightSample, f32, render_core::Vec3)> {
+) -> Option<(render_core::light::LightSample, f32, render_core::Vec3, f32)> {
     let s = scene.sample_light(light, sp.point(), u)?;
     let p = pmf * s.pdf;
     if !(p > 0.0) {
         return None;
     }
-    let f = sp.bsdf.eval_cos(sp.wo, s.wi) * s.radiance;
+    let v = sp.bsdf.eval(sp.wo, s.wi);
+    let f = v.f_cos * s.radiance;
     if f == render_core::Vec3::ZERO {
         return None;
     }
@@ -310,7 +312,7 @@ pub(crate) fn sample_observed<L: Learner>(
         hit,
         memory,
     );
-    hit.then_some((s, p, f))
+    hit.then_some((s, p, f, v.pdf))
 }
 
 impl Learner for LearnedSelection {

@@ -5,14 +5,17 @@
 use super::Learner;
 use super::regions::Observation;
 use super::selection::{LearnedSelection, sample_observed};
-use crate::bsdf_sampling::sample_bsdf;
-use crate::light_strategy::{Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
+use crate::bsdf_sampling::sample_bsdf_at;
+use crate::light_strategy::{PickNumbers, Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
 use crate::mis::power_heuristic;
 use crate::scratch::Pooled;
 use render_core::Vec3;
 use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
+
+/// A light sample without a pick (every light unreachable from the point).
+const NO_PICK: u32 = u32::MAX;
 
 /// A learned selection as a strategy.
 pub struct LearnedStrategy<S = LearnedSelection> {
@@ -55,48 +58,64 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
         Observation::clear(&mut ctx.pixel_memory[..]);
         ctx.counters
             .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
-        let mut picks = Pooled::<Picks>::take();
-        let x = sp.point();
-        let mut l = Vec3::ZERO;
+        // Every number first, in the order the samples use them (a light pick and its point
+        // per light sample, then the BSDF sample's), so that the picked lights' records can be
+        // fetched while the BSDF ray is traced.
         let n = self.light_samples.max(1);
-        // Where the second and later samples' observations go (one is learnt per pass).
-        let mut unlearnt = [0.0f32; PIXEL_MEMORY];
-        for i in 0..n {
-            picks.0.clear();
+        let mut picks = Pooled::<Picks>::take();
+        let mut numbers = Pooled::<PickNumbers>::take();
+        for _ in 0..n {
+            let drawn = picks.0.len();
             sel.pick(&state, sp, rng, &mut picks.0);
+            if picks.0.len() == drawn {
+                picks.0.push((NO_PICK, 0.0));
+            }
             // The point on the light is drawn even without a pick, so later draws keep their
             // dimensions.
-            let u = rng.next_2d();
-            ctx.counters.technique_samples[TECHNIQUE_LIGHT] += 1;
-            let Some(&(light, pmf)) = picks.0.first() else {
+            numbers.0.push(rng.next_2d());
+        }
+        ctx.counters.technique_samples[TECHNIQUE_LIGHT] += n as u64;
+        let bsdf_numbers = self.with_bsdf.then(|| (rng.next_f32(), rng.next_2d()));
+        for &(light, _) in &picks.0 {
+            if light != NO_PICK {
+                scene.prefetch_light(light);
+            }
+        }
+        let from_bsdf = bsdf_numbers.and_then(|(u_lobe, u)| {
+            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
+            let b = sample_bsdf_at(scene, sp, u_lobe, u, ctx.counters)?;
+            b.found_light().then(|| {
+                let p_light = sel.pmf(&state, sp, b.light)
+                    * scene.lights[b.light as usize].pdf(sp.point(), b.point, b.normal);
+                let w = power_heuristic(1, &[(n as f32, p_light), (1.0, b.pdf)]);
+                b.f_cos * b.radiance * (w / b.pdf)
+            })
+        });
+        let mut l = Vec3::ZERO;
+        // Where the second and later samples' observations go (one is learnt per pass).
+        let mut unlearnt = [0.0f32; PIXEL_MEMORY];
+        for (i, (&(light, pmf), &u)) in picks.0.iter().zip(&numbers.0).enumerate() {
+            if light == NO_PICK {
                 continue;
-            };
+            }
             let memory = if i == 0 {
                 &mut ctx.pixel_memory[..]
             } else {
                 &mut unlearnt[..]
             };
-            if let Some((s, p, f)) =
+            if let Some((s, p, f, p_bsdf)) =
                 sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, sel, &state)
             {
                 let w = if self.with_bsdf && !s.is_delta {
-                    power_heuristic(0, &[(n as f32, p), (1.0, sp.bsdf.pdf(sp.wo, s.wi))])
+                    power_heuristic(0, &[(n as f32, p), (1.0, p_bsdf)])
                 } else {
                     1.0
                 };
                 l += f * (w / (n as f32 * p));
             }
         }
-        if self.with_bsdf {
-            ctx.counters.technique_samples[TECHNIQUE_BSDF] += 1;
-            if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)
-                && b.found_light()
-            {
-                let p_light = sel.pmf(&state, sp, b.light)
-                    * scene.lights[b.light as usize].pdf(x, b.point, b.normal);
-                let w = power_heuristic(1, &[(n as f32, p_light), (1.0, b.pdf)]);
-                l += b.f_cos * b.radiance * (w / b.pdf);
-            }
+        if let Some(b) = from_bsdf {
+            l += b;
         }
         l
     }
