@@ -10,7 +10,7 @@ use render_core::sampler::Sampler;
 use render_core::splat::Reconstruction;
 use samplers::StrategyOptions;
 use samplers::brdf_oriented::{BoImportance, BrdfIntegral};
-use samplers::learned::{LearnTarget, LearnedConfig};
+use samplers::learned::{LearnTarget, LearnedConfig, PassWeights};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -221,6 +221,11 @@ pub struct MethodArgs {
     /// observed in a region keeps, and how fast its observations take over).
     #[arg(long, default_value_t = LearnedConfig::default().prior_strength)]
     pub learned_prior: f32,
+    /// `learned-descent`: how its passes are weighed in each pixel's average, `sqrt` (pass i
+    /// by √i: the later, better-learnt passes count more; unbiased) or `equal`.
+    #[arg(long, default_value = LearnedConfig::default().pass_weights.name(),
+          value_parser = pass_weights_parser())]
+    pub learned_pass_weights: PassWeights,
 }
 
 /// `--learned-target`: the names of [`LearnTarget`], listed in `--help`.
@@ -228,6 +233,13 @@ fn learn_target_parser() -> impl clap::builder::TypedValueParser<Value = LearnTa
     use clap::builder::{PossibleValuesParser, TypedValueParser};
     PossibleValuesParser::new(LearnTarget::ALL.map(LearnTarget::name))
         .map(|s| LearnTarget::from_name(&s).expect("a listed name"))
+}
+
+/// `--learned-pass-weights`: the names of [`PassWeights`], listed in `--help`.
+fn pass_weights_parser() -> impl clap::builder::TypedValueParser<Value = PassWeights> {
+    use clap::builder::{PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(PassWeights::ALL.map(PassWeights::name))
+        .map(|s| PassWeights::from_name(&s).expect("a listed name"))
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -327,6 +339,7 @@ impl MethodArgs {
                 defensive: self.learned_defensive,
                 light_samples: self.learned_samples,
                 prior_strength: self.learned_prior,
+                pass_weights: self.learned_pass_weights,
                 ..LearnedConfig::default()
             },
         }

@@ -110,6 +110,13 @@ pub trait DirectLighting: Send + Sync {
     ) -> Vec3;
     /// Called once before a render's first sample: forget what an earlier render taught.
     fn begin_render(&self) {}
+    /// The weight of pass `pass` (from 0) in every pixel's average, > 0: a function of the
+    /// pass's index alone, fixed before the render, so that a weighted average of unbiased
+    /// passes stays unbiased. A strategy whose later passes are better (it learns) can weigh
+    /// them more; 1 (a plain average) by default.
+    fn pass_weight(&self, _pass: u32) -> f64 {
+        1.0
+    }
     /// Called after each complete pass with every pixel's memory, in pixel order (so what the
     /// strategy learns is the same for any thread count); the next pass sees what it keeps.
     fn end_pass(&self, _pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {}

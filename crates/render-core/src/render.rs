@@ -347,7 +347,7 @@ impl PassJob<'_> {
     fn render_unit(
         &self,
         u: usize,
-        sample_index: u64,
+        (sample_index, pass_weight): (u64, f64),
         (unit, splats): (&mut [PixelAccum], &mut [PassSample]),
         c: &mut Counters,
     ) {
@@ -398,8 +398,8 @@ impl PassJob<'_> {
             // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
             for k in 0..3 {
                 let v = l[k] as f64;
-                px.sum[k] += v;
-                px.sum_sq[k] += v * v;
+                px.sum[k] += pass_weight * v;
+                px.sum_sq[k] += pass_weight * (v * v);
             }
             px.light_hits += sees_light as u32;
             for (acc, v) in px.aux.iter_mut().zip(aux).take(self.n_aux) {
@@ -597,6 +597,8 @@ pub fn render(
     }
     let mut spp_done = 0u32;
     let mut passes = 0u32;
+    // Each pass's weight, in order (the partial last one too).
+    let mut weights: Vec<f64> = Vec::new();
     let mut partial_pixels = 0usize;
     let stop = AtomicBool::new(false);
     loop {
@@ -609,6 +611,14 @@ pub fn render(
             break;
         }
         let sample_index = spp_done as u64;
+        let pass_weight = strategy.pass_weight(spp_done);
+        if !(pass_weight.is_finite() && pass_weight > 0.0) {
+            return Err(format!(
+                "strategy {}: the weight of pass {spp_done} is {pass_weight}, not a positive number",
+                strategy.name()
+            ));
+        }
+        weights.push(pass_weight);
         // Units are handed out in order, and every unit claimed is finished: the units done
         // in this pass are always a prefix of the image.
         let mut splat_chunks = splats.chunks_mut(UNIT_PIXELS);
@@ -633,7 +643,7 @@ pub fn render(
                 };
                 let mut unit = unit.lock().unwrap_or_else(|e| e.into_inner());
                 let (a, s) = &mut *unit;
-                job.render_unit(u, sample_index, (a, s), &mut c);
+                job.render_unit(u, (sample_index, pass_weight), (a, s), &mut c);
             }
             c
         });
@@ -645,7 +655,7 @@ pub fn render(
             // A budget spent before the first unit: take that one anyway, so every render has a sample.
             let mut unit = units[0].lock().unwrap_or_else(|e| e.into_inner());
             let (a, s) = &mut *unit;
-            job.render_unit(0, sample_index, (a, s), &mut counters);
+            job.render_unit(0, (sample_index, pass_weight), (a, s), &mut counters);
             done = 1;
         }
         let n_units = units.len();
@@ -654,7 +664,12 @@ pub fn render(
             break;
         }
         if let Some(film) = &mut film {
-            film.gather_pass(grid, &splats, (done * UNIT_PIXELS).min(grid.len()));
+            film.gather_pass(
+                grid,
+                &splats,
+                (done * UNIT_PIXELS).min(grid.len()),
+                pass_weight,
+            );
         }
         passes += 1;
         if done < n_units {
@@ -668,8 +683,9 @@ pub fn render(
         progress(passes, spp_done);
     }
     let samples = |i: usize| (spp_done + (i < partial_pixels) as u32) as f64;
+    let pass_weights = PassWeights::new(&weights);
     let image = match &film {
-        None => own_samples_image(&accum, samples),
+        None => own_samples_image(&accum, samples, &pass_weights),
         Some(film) => FinishedImage {
             pixels: film.pixels(),
             variance_of_mean: film.variance_of_mean(),
@@ -730,17 +746,49 @@ struct FinishedImage {
 }
 
 /// Each pixel the mean of its own samples (filter importance sampling), `samples(i)` of them.
-fn own_samples_image(accum: &[PixelAccum], samples: impl Fn(usize) -> f64) -> FinishedImage {
+/// The passes' weights as a pixel's average needs them: for n samples (the first n passes),
+/// W(n) = Σ wᵢ and Σ wᵢ².
+struct PassWeights {
+    /// Whether every weight is 1 (the plain average, computed as it always was).
+    uniform: bool,
+    sums: Vec<(f64, f64)>,
+}
+
+impl PassWeights {
+    fn new(weights: &[f64]) -> PassWeights {
+        let mut sums = vec![(0.0, 0.0)];
+        for &w in weights {
+            let (s, s2) = sums[sums.len() - 1];
+            sums.push((s + w, s2 + w * w));
+        }
+        PassWeights {
+            uniform: weights.iter().all(|&w| w == 1.0),
+            sums,
+        }
+    }
+
+    /// (W, Σ w²) of a pixel with `n` samples.
+    fn of(&self, n: f64) -> (f64, f64) {
+        self.sums.get(n as usize).copied().unwrap_or((n, n))
+    }
+}
+
+fn own_samples_image(
+    accum: &[PixelAccum],
+    samples: impl Fn(usize) -> f64,
+    weights: &PassWeights,
+) -> FinishedImage {
     let mean = |sum: f64, n: f64| if n > 0.0 { sum / n } else { 0.0 };
     let pixels = accum
         .iter()
         .enumerate()
         .map(|(i, p)| {
             let n = samples(i);
+            let w = if weights.uniform { n } else { weights.of(n).0 };
             Vec3::new(
-                mean(p.sum[0], n) as f32,
-                mean(p.sum[1], n) as f32,
-                mean(p.sum[2], n) as f32,
+                mean(p.sum[0], w) as f32,
+                mean(p.sum[1], w) as f32,
+                mean(p.sum[2], w) as f32,
             )
         })
         .collect();
@@ -752,6 +800,9 @@ fn own_samples_image(accum: &[PixelAccum], samples: impl Fn(usize) -> f64) -> Fi
             let v = |k: usize| {
                 if n < 2.0 {
                     return f32::INFINITY;
+                }
+                if !weights.uniform {
+                    return weighted_variance_of_mean(p.sum[k], p.sum_sq[k], weights.of(n));
                 }
                 let mean = p.sum[k] / n;
                 (((p.sum_sq[k] / n - mean * mean) * n / (n - 1.0)).max(0.0) / n) as f32
@@ -773,6 +824,19 @@ fn own_samples_image(accum: &[PixelAccum], samples: impl Fn(usize) -> f64) -> Fi
         light_fraction,
         unsampled: (0..accum.len()).filter(|&i| samples(i) == 0.0).count(),
     }
+}
+
+/// The variance of a weighted mean Σwx/W from Σwx, Σwx² and (W, Σw²), taking the samples as
+/// of one variance σ², estimated with reliability weights: σ̂² = (Σwx² − W·m²)/(W − Σw²/W),
+/// and Var = σ̂²·Σw²/W². (A learning strategy's later passes vary less: the estimate is then
+/// on the safe side for the later samples' weight.)
+fn weighted_variance_of_mean(sum: f64, sum_sq: f64, (w, w2): (f64, f64)) -> f32 {
+    let m = sum / w;
+    let dof = w - w2 / w;
+    if !(dof > 0.0) {
+        return f32::INFINITY;
+    }
+    ((sum_sq - w * m * m).max(0.0) / dof * w2 / (w * w)) as f32
 }
 
 #[cfg(test)]
@@ -800,6 +864,57 @@ mod tests {
             match scene.lights[i].sample(sp.point(), rng.next_2d()) {
                 Some(s) => sp.shade(scene, &s, ctx.counters) * n as f32 / s.pdf,
                 None => Vec3::ZERO,
+            }
+        }
+    }
+
+    /// Returns, at each pixel, how many samples it has taken (its count kept in the pixel's
+    /// memory), and weighs pass i by `weight(i)`.
+    struct CountingPasses(fn(u32) -> f64);
+
+    impl DirectLighting for CountingPasses {
+        fn name(&self) -> String {
+            "test-counting-passes".into()
+        }
+
+        fn estimate(
+            &self,
+            _: &Scene,
+            _: &ShadingPoint,
+            _: &mut SampleStream,
+            ctx: &mut SampleContext,
+        ) -> Vec3 {
+            ctx.pixel_memory[0] += 1.0;
+            Vec3::splat(ctx.pixel_memory[0])
+        }
+
+        fn pass_weight(&self, pass: u32) -> f64 {
+            (self.0)(pass)
+        }
+    }
+
+    /// A pixel's value is Σ wᵢxᵢ/Σ wᵢ over its passes: with xᵢ = wᵢ = i (from 1) and four
+    /// passes, 30/10 = 3, against the plain mean 2.5; a weight that is not positive is an error.
+    #[test]
+    fn passes_are_averaged_with_the_strategys_weights() {
+        let scene = test_scene();
+        let s = settings(&scene, Some(4), None, 2, Sampler::Independent);
+        let plain = render(&scene, &CountingPasses(|_| 1.0), &s, &|_, _| {}).unwrap();
+        let weighted =
+            render(&scene, &CountingPasses(|i| i as f64 + 1.0), &s, &|_, _| {}).unwrap();
+        // The pixels whose every sample saw the floor (the others mix in the sky's zeros).
+        let floor: Vec<usize> = (0..plain.pixels.len())
+            .filter(|&i| plain.pixels[i] == Vec3::splat(2.5))
+            .collect();
+        assert!(floor.len() > 1000, "{}", floor.len());
+        for &i in &floor {
+            assert_eq!(weighted.pixels[i], Vec3::splat(3.0));
+            assert!(weighted.variance_of_mean[i].is_finite());
+        }
+        for bad in [|_| 0.0, |_| -1.0, |_| f64::NAN] {
+            match render(&scene, &CountingPasses(bad), &s, &|_, _| {}) {
+                Err(e) => assert!(e.contains("weight of pass 0"), "{e}"),
+                Ok(_) => panic!("a weight that is not positive was taken"),
             }
         }
     }

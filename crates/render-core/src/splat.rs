@@ -156,7 +156,15 @@ impl SplatFilm {
 
     /// Adds the samples of one pass: `samples[i]` for sample pixel `i` of `grid`, only the
     /// first `taken` of which were rendered in this pass.
-    pub fn gather_pass(&mut self, grid: SampleGrid, samples: &[PassSample], taken: usize) {
+    /// `pass_weight`: the pass's weight in every pixel's average (its filter weights are
+    /// scaled by it).
+    pub fn gather_pass(
+        &mut self,
+        grid: SampleGrid,
+        samples: &[PassSample],
+        taken: usize,
+        pass_weight: f64,
+    ) {
         let r = self.filter.radius();
         let reach = r.ceil() as i64 + 1;
         let width = self.width;
@@ -184,7 +192,7 @@ impl SplatFilm {
                             continue;
                         }
                         any = true;
-                        let w = (this.weight_1d(d.x) * this.weight_1d(d.y)) as f64;
+                        let w = (this.weight_1d(d.x) * this.weight_1d(d.y)) as f64 * pass_weight;
                         for k in 0..3 {
                             fl[k] += w * s.radiance[k] as f64;
                         }
@@ -304,7 +312,7 @@ mod tests {
         let grid = SampleGrid::new(6, 5, Reconstruction::Splat, &filter);
         let mut film = SplatFilm::new(6, 5, filter);
         for u in [Vec2::new(0.1, 0.7), Vec2::new(0.93, 0.02)] {
-            film.gather_pass(grid, &constant_pass(grid, u, 2.0), grid.len());
+            film.gather_pass(grid, &constant_pass(grid, u, 2.0), grid.len(), 1.0);
         }
         for p in film.pixels() {
             assert!((p - Vec3::splat(2.0)).abs().max_element() < 1e-6, "{p}");
@@ -323,7 +331,7 @@ mod tests {
             s.radiance = Vec3::splat(i as f32);
         }
         let mut film = SplatFilm::new(4, 3, filter);
-        film.gather_pass(grid, &samples, grid.len());
+        film.gather_pass(grid, &samples, grid.len(), 1.0);
         let expect: Vec<Vec3> = (0..12).map(|i| Vec3::splat(i as f32)).collect();
         assert_eq!(film.pixels(), expect);
     }
@@ -338,6 +346,7 @@ mod tests {
             grid,
             &constant_pass(grid, Vec2::splat(0.5), 1.0),
             grid.width * 2,
+            1.0,
         );
         let px = film.pixels();
         assert_eq!(px[0], Vec3::ONE);
@@ -354,7 +363,7 @@ mod tests {
         samples[centre].film += Vec2::new(0.3, 0.2);
         samples[centre].sees_light = true;
         let mut film = SplatFilm::new(5, 5, filter);
-        film.gather_pass(grid, &samples, grid.len());
+        film.gather_pass(grid, &samples, grid.len(), 1.0);
         let lit: Vec<usize> = (0..25)
             .filter(|&i| film.light_fraction()[i] > 0.0)
             .collect();

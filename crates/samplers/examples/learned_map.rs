@@ -48,6 +48,7 @@ fn main() -> Result<(), String> {
         selection: LearnedSelection::new(&scene, PowerUnits::Watts, config)?,
         with_bsdf: true,
         light_samples: 1,
+        pass_weights: samplers::learned::PassWeights::Equal,
     };
     let camera = scene.camera(None).map_err(|e| e.to_string())?;
     let settings = RenderSettings {

@@ -368,6 +368,7 @@ pub fn create(
                 .map_err(StrategyError::BadOption)?,
             with_bsdf: name == "learned+bsdf",
             light_samples: opts.learned.light_samples,
+            pass_weights: learned::PassWeights::Equal,
         }),
         "learned-descent" | "learned-descent+bsdf" => {
             Box::new(learned::strategy::LearnedStrategy {
@@ -376,6 +377,7 @@ pub fn create(
                     .map_err(StrategyError::BadOption)?,
                 with_bsdf: name == "learned-descent+bsdf",
                 light_samples: opts.learned.light_samples,
+                pass_weights: opts.learned.pass_weights,
             })
         }
         "oracle" | "oracle-shadowed" => Box::new(LightStrategy {

@@ -120,14 +120,14 @@ pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, 
         "mis3-adaptive-learned" => json!({
             "power_units": units(opts),
             "ls": "learned",
-            "learned": opts.learned,
+            "learned": cluster_learned(opts),
             "method": bo_config(opts),
             "integral": integral(opts),
         }),
         "learned" | "learned+bsdf" => json!({
             "power_units": units(opts),
             "cut": "breadth-first",
-            "learned": opts.learned,
+            "learned": cluster_learned(opts),
         }),
         "learned-descent" | "learned-descent+bsdf" => json!({
             "power_units": units(opts),
@@ -224,5 +224,13 @@ mod tests {
         ));
         let bad = StrategyOptions { lambda: -1.0, ..d };
         assert!(resolved_parameters("tree", &bad).is_err());
+    }
+}
+
+/// The learned options as the cluster strategies use them: their passes always weigh alike.
+fn cluster_learned(opts: &StrategyOptions) -> crate::learned::LearnedConfig {
+    crate::learned::LearnedConfig {
+        pass_weights: crate::learned::PassWeights::Equal,
+        ..opts.learned
     }
 }

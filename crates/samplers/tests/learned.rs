@@ -34,6 +34,7 @@ fn learned(scene: &Scene, target: LearnTarget) -> LearnedStrategy {
         selection: LearnedSelection::new(scene, PowerUnits::Watts, config).unwrap(),
         with_bsdf: true,
         light_samples: 1,
+        pass_weights: samplers::learned::PassWeights::Equal,
     }
 }
 
@@ -242,6 +243,7 @@ fn learned_descent_splits_by_the_observed_ratios() {
         selection: DescentSelection::new(&scene, PowerUnits::Watts, config).unwrap(),
         with_bsdf: false,
         light_samples: 1,
+        pass_weights: samplers::learned::PassWeights::Equal,
     };
     let sel = &s.selection;
     let lt = sel.tree.tree.as_ref().unwrap();
@@ -315,6 +317,7 @@ fn descent(scene: &Scene) -> LearnedStrategy<DescentSelection> {
             .unwrap(),
         with_bsdf: true,
         light_samples: 1,
+        pass_weights: samplers::learned::PassWeights::Equal,
     }
 }
 

@@ -27,6 +27,8 @@ pub struct LearnedStrategy<S = LearnedSelection> {
     pub with_bsdf: bool,
     /// Light samples per shading point (at least 1).
     pub light_samples: u32,
+    /// How the passes are weighed in each pixel's average.
+    pub pass_weights: super::PassWeights,
 }
 
 impl<S: Learner> DirectLighting for LearnedStrategy<S> {
@@ -35,7 +37,9 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
     }
 
     fn parameters(&self) -> serde_json::Value {
-        self.selection.describe()
+        let mut p = self.selection.describe();
+        p["pass_weights"] = serde_json::json!(self.pass_weights.name());
+        p
     }
 
     fn techniques(&self) -> Vec<&'static str> {
@@ -122,6 +126,10 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
 
     fn begin_render(&self) {
         self.selection.forget();
+    }
+
+    fn pass_weight(&self, pass: u32) -> f64 {
+        self.pass_weights.weight(pass)
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
