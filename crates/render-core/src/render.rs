@@ -900,8 +900,7 @@ mod tests {
         let scene = test_scene();
         let s = settings(&scene, Some(4), None, 2, Sampler::Independent);
         let plain = render(&scene, &CountingPasses(|_| 1.0), &s, &|_, _| {}).unwrap();
-        let weighted =
-            render(&scene, &CountingPasses(|i| i as f64 + 1.0), &s, &|_, _| {}).unwrap();
+        let weighted = render(&scene, &CountingPasses(|i| i as f64 + 1.0), &s, &|_, _| {}).unwrap();
         // The pixels whose every sample saw the floor (the others mix in the sky's zeros).
         let floor: Vec<usize> = (0..plain.pixels.len())
             .filter(|&i| plain.pixels[i] == Vec3::splat(2.5))
