@@ -1,22 +1,24 @@
 //! The learned descent: per region, a factor learnt for every node of the light tree's top
-//! levels (all of them up to 4,096 learnt pairs and depth [`LEVELS`]), which multiplies the node's unshadowed importance at each step of the
-//! descent (after Pantaleoni 2019, *Importance sampling of many lights with reinforcement
-//! lightcuts learning*, and in the role of Vévoda et al. 2018's per-region cut). The cluster
-//! selection learns one level (its cut); this one learns down to clusters of a few lights, so
-//! it also corrects the tree's bounds inside what the cluster selection treats as one unit.
+//! levels (all of them up to 4,096 learnt pairs and depth [`LEVELS`]), which multiplies the
+//! node's unshadowed importance at each step of the descent (after Pantaleoni 2019,
+//! *Importance sampling of many lights with reinforcement lightcuts learning*, and in the role
+//! of Vévoda et al. 2018's per-region cut). The cluster selection learns one level (its cut);
+//! this one learns down to single lights, so it also corrects the tree's bounds inside what the
+//! cluster selection treats as one unit.
 //!
 //! What is learnt: a sample of light l, drawn with probability P(l) through node n (reached
 //! with probability P(n)), estimates n's shadowed contribution T_n at the point as
 //! Y · P(n), Y = lum(f·L·V)/(P(l) p_point); its ratio to n's importance I_n,
 //! ρ_n = Y · P(n)/I_n, has mean T_n/I_n given that the sample went through n. A region's
 //! factor of n is ρ̄_n shrunk towards its parent's, r̂_n = (Σρ_n + a·r̂_parent)/(rays_n + a),
-//! the root's the mean of its ratios (1 before any), so a node not yet observed keeps its
-//! parent's factor and the tree's own split below it.
+//! the root's the mean of its children's ratios (1 before any), so a node not yet observed
+//! keeps its parent's factor and the tree's own split below it.
 //!
-//! Sampling: with probability 1 − α the descent goes left ∝ I_left·r̂_left against
-//! I_right·r̂_right, otherwise ∝ the importances alone (the tree's descent); the pmf of a light
-//! is (1 − α)·Q(l) + α·T(l), both products replayed along its trail with the same operations,
-//! so every light the tree reaches keeps at least α times its tree probability.
+//! Sampling (`descent_walk.rs`): with probability 1 − α the walk chooses among a step's eight
+//! lanes ∝ importance × factor, otherwise ∝ the importances alone (the tree's descent); the
+//! pmf of a light is (1 − α)·Q(l) + α·T(l), both products replayed along its trail with the
+//! same operations, so every light the tree reaches keeps at least α times its tree
+//! probability.
 use super::descent_table::{
     DescentObservation, DescentTable, LEVELS, MAX_TABLE_BYTES, NodeTally, learnt_pairs,
 };
@@ -120,8 +122,8 @@ fn root_factor(tallies: &[[NodeTally; 2]]) -> f32 {
     })
 }
 
-/// One shading point: its region and receiver, and the ratios' per-level scales of the last
-/// pick (for its observation).
+/// One shading point: its region and receiver, and the per-level scales of its first pick
+/// (for its observation).
 pub struct DescentState {
     table: Arc<DescentTable>,
     /// The first of the region's pairs in the table, if the region has been seen.
