@@ -89,7 +89,7 @@ pub struct StrategyArgs {
     /// straddle a light's edge (every pixel in the first pass, then those near a light not yet
     /// seen to be fully inside one): 1 (the default) traces only the sample's own ray; more
     /// lowers the noise of a pixel's coverage of the lights, which light sampling never touches.
-    /// Needs the sampled reconstruction. [default: 16 for mis3-adaptive without --reproduce
+    /// Needs the sampled reconstruction. [default: 16 for mis3-adaptive and mis3-adaptive-learned without --reproduce
     /// (results/paper at bb1cfa3: over all pixels 3.68× E&K against 0.95× with 1), else 1]
     #[arg(long, value_parser = emission_rays_parser)]
     pub emission_rays: Option<u32>,
@@ -111,10 +111,11 @@ impl StrategyArgs {
 
     /// `--emission-rays`, or its default: [`METHOD_EMISSION_RAYS`] for our `mis3-adaptive`
     /// (its few spp per pixel leave the coverage noise of pixels that see a light; the paper
-    /// experiment chose it), one ray for every other strategy and for the authors' settings.
+    /// experiment chose it) and for its learned variant, so that the two compare like with like;
+    /// one ray for every other strategy and for the authors' settings.
     pub fn emission_rays(&self) -> u32 {
         self.emission_rays.unwrap_or(
-            if self.strategy == "mis3-adaptive" && !self.method.reproduce {
+            if self.strategy.starts_with("mis3-adaptive") && !self.method.reproduce {
                 METHOD_EMISSION_RAYS
             } else {
                 1

@@ -802,6 +802,12 @@ fn scene_hash_covers_included_files_and_render_records_what_strategy_resolves() 
     assert_eq!(resolved["parameters"]["method"]["lambda"], 3.0);
     assert_eq!(resolved["parameters"]["method"]["n_max"], 50, "a default");
     assert_eq!(resolved["emission_rays"], 16, "the method's default");
+    let learned = ["strategy", "--json", "--strategy", "mis3-adaptive-learned"];
+    assert_eq!(
+        json_of(&manylights(&learned))["emission_rays"],
+        16,
+        "the method's learned variant compares with it like for like"
+    );
     for other in [
         vec![
             "strategy",
