@@ -252,7 +252,7 @@ pub fn strategies() -> Vec<StrategyInfo> {
         s("learned+bsdf", "learned + BSDF sampling, MIS"),
         s(
             "learned-descent",
-            "learned descent (issue 25): the tree's descent with a factor per node of its top 11 levels, its contribution over its importance learnt per region in earlier passes (+20 % the plain descent)",
+            "learned descent (issue 25): the tree's descent with a factor per node of its top levels (all of them up to 4,096 sibling pairs per region), its contribution over its importance learnt per region in earlier passes (+20 % the plain descent)",
         ),
         s(
             "learned-descent+bsdf",
