@@ -233,7 +233,8 @@ where
 
     fn begin_render(&self) {
         if let Some(l) = &self.learned {
-            l.table.write().unwrap_or_else(|e| e.into_inner()).clear();
+            use crate::learned::Learner;
+            l.forget();
         }
         self.n_max_now
             .store((self.config.n_max as f32).to_bits(), Ordering::Relaxed);

@@ -253,6 +253,10 @@ impl Learner for DescentSelection {
         .write(memory, state.stamp);
     }
 
+    fn clear_observation(&self, memory: &mut [f32]) {
+        DescentObservation::clear(memory);
+    }
+
     fn forget(&self) {
         let mut guard = self.table.write().unwrap_or_else(|e| e.into_inner());
         let (pairs, max_regions) = (guard.pairs, guard.max_regions);

@@ -194,6 +194,11 @@ impl DescentObservation {
         }
     }
 
+    /// Marks `memory` as holding no observation (its stamp 0, which no pass has).
+    pub fn clear(memory: &mut [f32]) {
+        memory[0] = 0.0;
+    }
+
     /// The observation of pass `stamp` in `memory`, if it holds one.
     pub fn read(memory: &[f32; PIXEL_MEMORY], stamp: u32) -> Option<DescentObservation> {
         if memory[0] != stamp as f32 {

@@ -120,6 +120,8 @@ impl WalkInput<'_> {
         let (mut q, mut t) = (1.0f32, 1.0f32);
         let mut scales = [0.0f32; LEVELS];
         let mut depth = 0usize;
+        // Only a drawn pick is observed: a pmf replay (a trail) leaves its scales at 0.
+        let observed = matches!(steer, Steer::Draw { .. });
         loop {
             let node = lt.node(id);
             if let Some(light) = node.light() {
@@ -179,7 +181,7 @@ impl WalkInput<'_> {
             // The levels passed: the half, the quarter and the lane (as far as the lane's node
             // lies below), each weighing the sum of its lanes.
             let below = plan.below[k] as usize;
-            for level in 1..=below {
+            for level in (1..=below).filter(|_| observed) {
                 let span = 8 >> level;
                 let first = k / span * span;
                 let i = range_sum(&g, first, span);

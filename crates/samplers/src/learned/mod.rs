@@ -43,6 +43,9 @@ pub trait Learner: LightSelection {
         hit: bool,
         memory: &mut [f32],
     );
+    /// Marks `memory` (the pixel's) as holding no observation of this pass, before a sample
+    /// that may leave none.
+    fn clear_observation(&self, memory: &mut [f32]);
     /// Forgets everything learnt (a new render).
     fn forget(&self);
     /// Merges the observations the pass just finished left in the pixels' memory, in pixel

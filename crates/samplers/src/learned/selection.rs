@@ -346,6 +346,10 @@ impl Learner for LearnedSelection {
         .write(memory, state.stamp);
     }
 
+    fn clear_observation(&self, memory: &mut [f32]) {
+        super::regions::Observation::clear(memory);
+    }
+
     fn forget(&self) {
         self.table
             .write()

@@ -3,7 +3,6 @@
 //! first light sample leaving its observation in the pixel's memory for the merge between
 //! passes.
 use super::Learner;
-use super::regions::Observation;
 use super::selection::{LearnedSelection, sample_observed};
 use crate::bsdf_sampling::sample_bsdf_at;
 use crate::light_strategy::{PickNumbers, Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
@@ -59,7 +58,7 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
     ) -> Vec3 {
         let sel = &self.selection;
         let state = sel.prepare(scene, sp);
-        Observation::clear(&mut ctx.pixel_memory[..]);
+        sel.clear_observation(&mut ctx.pixel_memory[..]);
         ctx.counters
             .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
         // Every number first, in the order the samples use them (a light pick and its point
