@@ -37,8 +37,13 @@ enum Command {
     },
     /// List the built-in scenes and their keys.
     Scenes,
-    /// List the strategies.
-    Strategies,
+    /// List the strategies, each with its description (and with --json its knobs, their
+    /// defaults and its emission rays).
+    Strategies {
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
     /// Print a strategy's resolved parameters (every default filled in) and sampler as JSON:
     /// what `render` with the same flags records as `resolved_strategy`.
     Strategy {
@@ -101,12 +106,7 @@ fn main() -> ExitCode {
             println!("{}", serde_json::to_string_pretty(&v)?);
             Ok(())
         }),
-        Command::Strategies => {
-            for s in samplers::strategies() {
-                println!("{:<18} {}", s.name, s.description);
-            }
-            Ok(())
-        }
+        Command::Strategies { json } => list_strategies(json),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -115,6 +115,34 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+fn list_strategies(json: bool) -> anyhow::Result<()> {
+    let defaults = samplers::StrategyOptions::default();
+    if !json {
+        for s in samplers::strategies() {
+            println!("{:<22} {}", s.name, s.description);
+        }
+        return Ok(());
+    }
+    let list: Vec<serde_json::Value> = samplers::strategies()
+        .iter()
+        .map(|s| {
+            let knobs: Vec<serde_json::Value> = std::iter::once(samplers::knobs::REPRODUCE)
+                .chain(s.knobs.iter().copied())
+                .filter_map(samplers::knobs::knob)
+                .map(|k| serde_json::json!({ "flag": format!("--{}", k.flag), "default": k.default_value(), "help": k.help }))
+                .collect();
+            serde_json::json!({
+                "name": s.name,
+                "description": s.description,
+                "knobs": knobs,
+                "emission_rays": s.default_emission_rays(&defaults),
+            })
+        })
+        .collect();
+    println!("{}", serde_json::to_string_pretty(&list)?);
+    Ok(())
 }
 
 fn list_scenes() {

@@ -223,6 +223,14 @@ fn bad_input_fails_cleanly() {
             r(SCENE, &["--strategy", "no-such-strategy"]),
             "unknown strategy",
         ),
+        (
+            r(SCENE, &["--strategy", "mis3-adaptve"]),
+            "did you mean `mis3-adaptive`",
+        ),
+        (
+            r(SCENE, &["--strategy", "power+bsdf", "--delta", "0.3"]),
+            "`power+bsdf` does not take `--delta`; it takes --reproduce",
+        ),
         (r("builtin:no-such-scene", &[]), "no-such-scene"),
         (r("builtin:glossy-spheres?lightz=4", &[]), "lightz"),
         (r("builtin:glossy-spheres?lights=many", &[]), "lights"),
@@ -846,4 +854,31 @@ fn scene_hash_covers_included_files_and_render_records_what_strategy_resolves() 
     let o = manylights(&["strategy", "--strategy", "no-such"]);
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("unknown strategy `no-such`"));
+}
+
+/// `render --help` documents every flag: each option line has its help on the same line or the
+/// next, more indented one.
+#[test]
+fn render_help_documents_every_flag() {
+    let o = manylights(&["render", "--help"]);
+    assert!(o.status.success());
+    let text = String::from_utf8_lossy(&o.stdout).into_owned();
+    let lines: Vec<&str> = text.lines().collect();
+    let mut flags = 0;
+    for (i, line) in lines.iter().enumerate() {
+        let t = line.trim_start();
+        if !(t.starts_with("--") || t.starts_with("-h, ")) {
+            continue;
+        }
+        flags += 1;
+        let indent = line.len() - t.len();
+        let spec_end = t.find("  ").unwrap_or(t.len());
+        let same_line = !t[spec_end..].trim().is_empty();
+        let next = lines.get(i + 1).copied().unwrap_or("");
+        let next_line = !next.trim().is_empty()
+            && next.len() - next.trim_start().len() > indent
+            && !next.trim_start().starts_with('-');
+        assert!(same_line || next_line, "no help for `{}`", t);
+    }
+    assert!(flags > 30, "only {flags} flags found in:\n{text}");
 }

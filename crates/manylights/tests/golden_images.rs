@@ -101,18 +101,6 @@ fn variants() -> Vec<(&'static str, StrategyOptions)> {
     ]
 }
 
-/// Strategies that use the variant's flags (the others would repeat the default's hash).
-fn uses_variant(strategy: &str, variant: &str) -> bool {
-    match variant {
-        "default" => true,
-        "reproduce" => strategy.starts_with("tree") || strategy.starts_with("mis3"),
-        "learned-visibility" => {
-            strategy.contains("learned") && !strategy.starts_with("learned-descent")
-        }
-        _ => strategy == "mis3-adaptive" || strategy == "ris-adaptive",
-    }
-}
-
 const PBRT_SCENE: &str = r#"LookAt 0 1 4  0 0.8 0  0 1 0
 Camera "perspective" "float fov" [ 45 ]
 WorldBegin
@@ -203,13 +191,20 @@ fn every_strategy_renders_the_committed_bytes() {
     let mut now = BTreeMap::new();
     for (scene_name, scene) in scenes(&dir) {
         for info in samplers::strategies() {
+            for v in info.golden_variants {
+                assert!(
+                    variants().iter().any(|(name, _)| name == v),
+                    "{}: no golden variant `{v}`",
+                    info.name
+                );
+            }
             // The shadowed oracle traces a ray per light and stratum at every point: on the
             // 80,000 lights of emissive-mesh that alone would add a minute to the suite.
             if info.name == "oracle-shadowed" && scene.lights.len() > 10_000 {
                 continue;
             }
             for (variant, opts) in variants() {
-                if uses_variant(info.name, variant) {
+                if variant == "default" || info.golden_variants.contains(&variant) {
                     let hash = render_case(&scene, info.name, &opts);
                     now.insert(
                         format!("{scene_name} {} {variant}", info.name),

@@ -99,6 +99,11 @@ pub trait DirectLighting: Send + Sync {
     fn aux_channels(&self) -> Vec<&'static str> {
         Vec::new()
     }
+    /// The false colour of a pixel's value `v` of aux channel `channel` in its PNG preview, or
+    /// `None` for a channel shown only as EXR.
+    fn aux_colour(&self, _channel: &str, _v: f32) -> Option<Vec3> {
+        None
+    }
     /// An unbiased (unless documented otherwise) estimate of the radiance reflected towards
     /// `sp.wo` from the scene's bounded lights.
     fn estimate(

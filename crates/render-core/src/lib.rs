@@ -30,6 +30,7 @@ pub mod scene_hash;
 pub mod scene_hints;
 pub mod splat;
 pub mod stats;
+pub mod suggest;
 pub mod texture;
 
 pub use pixel_samples::{filter, rng, sampler, zsobol};

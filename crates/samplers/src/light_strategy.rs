@@ -3,7 +3,8 @@
 use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
 use crate::mis::power2;
 use crate::scratch::Pooled;
-use crate::selection::LightSelection;
+use crate::selection::{LightSelection, PowerSelection, UniformSelection};
+use crate::strategy::Strategy;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
 use render_core::light::LightSample;
 use render_core::rng::SampleStream;
@@ -170,3 +171,53 @@ impl DirectLighting for BsdfStrategy {
         }
     }
 }
+
+fn no_parameters(_: &str, _: &crate::StrategyOptions) -> serde_json::Value {
+    serde_json::json!({})
+}
+
+/// A strategy of one selection with or without BSDF sampling, recording no parameters.
+fn plain<S: LightSelection + 'static>(
+    name: &str,
+    selection: S,
+    with_bsdf: bool,
+) -> Result<Box<dyn DirectLighting>, crate::StrategyError> {
+    Ok(Box::new(LightStrategy {
+        name: name.into(),
+        selection,
+        with_bsdf,
+        parameters: serde_json::Value::Null,
+    }))
+}
+
+/// `uniform`.
+pub const UNIFORM: Strategy = Strategy::new(
+    "uniform",
+    "one light chosen uniformly, sampled by its shape",
+    no_parameters,
+    |name, scene, _| plain(name, UniformSelection::new(scene), false),
+);
+
+/// `power`.
+pub const POWER: Strategy = Strategy::new(
+    "power",
+    "one light chosen by power (alias table), sampled by its shape",
+    no_parameters,
+    |name, scene, _| plain(name, PowerSelection::new(scene), false),
+);
+
+/// `bsdf`.
+pub const BSDF: Strategy = Strategy::new(
+    "bsdf",
+    "BSDF sampling only (misses delta lights)",
+    no_parameters,
+    |_, _, _| Ok(Box::new(BsdfStrategy)),
+);
+
+/// `power+bsdf`.
+pub const POWER_BSDF: Strategy = Strategy::new(
+    "power+bsdf",
+    "power light sampling and BSDF sampling, power-heuristic MIS",
+    no_parameters,
+    |name, scene, _| plain(name, PowerSelection::new(scene), true),
+);

@@ -5,7 +5,7 @@
 //! of exactly the strategies that use it).
 use crate::brdf_oriented::{BoConfig, BoImportance, BrdfIntegral};
 use crate::tree_selection::PowerUnits;
-use crate::{StrategyError, StrategyOptions, oracle, ris_count, strategies};
+use crate::{StrategyError, StrategyOptions};
 use brdf_integrals::{Intersection, Lookup, Ltc, Normalization, Sptd};
 use light_tree::SplitParams;
 use serde_json::{Value, json};
@@ -36,14 +36,14 @@ pub fn bo_config(opts: &StrategyOptions) -> BoConfig {
     }
 }
 
-fn units(opts: &StrategyOptions) -> &'static str {
+pub(crate) fn units(opts: &StrategyOptions) -> &'static str {
     match opts.power_units() {
         PowerUnits::Watts => "watts",
         PowerUnits::Authors => "authors",
     }
 }
 
-fn split(p: SplitParams) -> Value {
+pub(crate) fn split(p: SplitParams) -> Value {
     json!({
         "tau": p.tau,
         // usize::MAX (no cap) as null: JSON numbers beyond 2^53 do not round-trip.
@@ -79,7 +79,7 @@ fn lower(x: impl std::fmt::Debug) -> String {
 }
 
 /// How the cap integral is evaluated, read off the objects [`sptd`] and [`ltc`] build.
-fn integral(opts: &StrategyOptions) -> Value {
+pub(crate) fn integral(opts: &StrategyOptions) -> Value {
     match opts.brdf_integral {
         BrdfIntegral::Sptd => {
             let s = sptd(opts);
@@ -98,73 +98,7 @@ fn integral(opts: &StrategyOptions) -> Value {
 /// strategies without parameters), or the error [`crate::create`] would give for them.
 pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, StrategyError> {
     crate::check_options(opts)?;
-    Ok(match name {
-        "uniform" | "power" | "power+bsdf" | "bsdf" => json!({}),
-        "tree" | "tree+bsdf" => json!({ "tree": "single", "power_units": units(opts) }),
-        "sg-tree" | "sg-tree+bsdf" => json!({
-            "tree": "single, spherical-Gaussian importance",
-            "power_units": units(opts),
-            "floor": crate::sg::importance::FLOOR,
-        }),
-        "tree-split" | "tree-split+bsdf" => json!({
-            "tree": "split",
-            "power_units": units(opts),
-            "split": split(opts.split_params()),
-        }),
-        "brdf-oriented" | "mis3-equal" | "mis3-adaptive" => json!({
-            "power_units": units(opts),
-            "ls_split": split(opts.split_params()),
-            "method": bo_config(opts),
-            "integral": integral(opts),
-        }),
-        "mis3-adaptive-learned" => json!({
-            "power_units": units(opts),
-            "ls": "learned",
-            "learned": cluster_learned(opts),
-            "method": bo_config(opts),
-            "integral": integral(opts),
-        }),
-        "learned" | "learned+bsdf" => json!({
-            "power_units": units(opts),
-            "cut": "breadth-first",
-            "learned": cluster_learned(opts),
-        }),
-        "learned-descent" | "learned-descent+bsdf" => json!({
-            "power_units": units(opts),
-            "max_levels": crate::learned::descent_table::LEVELS,
-            "max_pairs_per_region": crate::learned::descent_table::MAX_PAIRS,
-            "learned": opts.learned,
-        }),
-        "oracle" | "oracle-shadowed" => {
-            let mut p = json!({
-                "defensive_power_fraction": oracle::DEFENSIVE,
-                "strata_per_side": oracle::STRATA_PER_SIDE,
-            });
-            // Only the new variant names it, so that the oracle's parameters stay as they were.
-            if name == "oracle-shadowed" {
-                p["shadowed"] = json!(true);
-            }
-            p
-        }
-        other if ris_count(other).is_some() => json!({
-            "candidates": ris_count(other),
-            "delta": opts.delta,
-            "max_cut": opts.max_cut,
-            "power_units": units(opts),
-            // RIS builds its integral with the default options, `reproduce` or not.
-            "integral": integral(&StrategyOptions { reproduce: false, ..opts.clone() }),
-        }),
-        other => {
-            return Err(StrategyError::Unknown {
-                name: other.into(),
-                known: strategies()
-                    .iter()
-                    .map(|s| s.name)
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            });
-        }
-    })
+    Ok((crate::registry::find(name)?.resolve)(name, opts))
 }
 
 #[cfg(test)]
@@ -215,7 +149,7 @@ mod tests {
     #[test]
     fn every_listed_strategy_resolves_and_bad_input_is_an_error() {
         let d = StrategyOptions::default();
-        for s in strategies() {
+        for s in crate::strategies() {
             assert!(resolved_parameters(s.name, &d).is_ok(), "{}", s.name);
         }
         assert!(matches!(
@@ -224,13 +158,5 @@ mod tests {
         ));
         let bad = StrategyOptions { lambda: -1.0, ..d };
         assert!(resolved_parameters("tree", &bad).is_err());
-    }
-}
-
-/// The learned options as the cluster strategies use them: their passes always weigh alike.
-fn cluster_learned(opts: &StrategyOptions) -> crate::learned::LearnedConfig {
-    crate::learned::LearnedConfig {
-        pass_weights: crate::learned::PassWeights::Equal,
-        ..opts.learned
     }
 }

@@ -1,10 +1,14 @@
 //! Light-tree selection (Conty Estevez & Kulla 2018): a single stochastic descent, or
 //! adaptive splitting into a cut with one light drawn per cluster.
+use crate::light_strategy::LightStrategy;
 use crate::memo::OctMemo;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
+use crate::strategy::Strategy;
+use crate::{StrategyError, StrategyOptions, resolve};
 use light_tree::{Cut, LightBounds, LightTree, NodeId, Rescaled, SplitParams};
 use render_core::Vec3;
+use render_core::estimator::DirectLighting;
 use render_core::estimator::ShadingPoint;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
@@ -241,3 +245,95 @@ impl LightSelection for TreeSelection {
         }
     }
 }
+
+/// A tree strategy's estimator: the tree in `mode`, with or without BSDF sampling.
+fn tree_strategy(
+    name: &str,
+    scene: &Scene,
+    opts: &StrategyOptions,
+    split: bool,
+    with_bsdf: bool,
+) -> Result<Box<dyn DirectLighting>, StrategyError> {
+    let (mode, parameters) = if split {
+        let p = opts.split_params();
+        let parameters = serde_json::json!({
+            "tau": p.tau,
+            "max_cut": opts.max_cut,
+            "split_criterion": format!("{:?}", p.criterion).to_lowercase(),
+            "reproduce": opts.reproduce,
+        });
+        (TreeMode::Split(p), parameters)
+    } else {
+        let parameters = serde_json::json!({ "reproduce": opts.reproduce });
+        (TreeMode::Single, parameters)
+    };
+    let selection =
+        TreeSelection::new(scene, mode, opts.power_units()).map_err(StrategyError::BadOption)?;
+    Ok(Box::new(LightStrategy {
+        name: name.into(),
+        selection,
+        with_bsdf,
+        parameters,
+    }))
+}
+
+fn resolve_single(_: &str, opts: &StrategyOptions) -> serde_json::Value {
+    serde_json::json!({ "tree": "single", "power_units": resolve::units(opts) })
+}
+
+fn resolve_split(_: &str, opts: &StrategyOptions) -> serde_json::Value {
+    serde_json::json!({
+        "tree": "split",
+        "power_units": resolve::units(opts),
+        "split": resolve::split(opts.split_params()),
+    })
+}
+
+/// The knobs of the split tree strategies.
+const SPLIT_KNOBS: &[&str] = &["tau", "max-cut"];
+
+/// `tree`.
+pub const TREE: Strategy = Strategy {
+    golden_variants: &["reproduce"],
+    ..Strategy::new(
+        "tree",
+        "light tree, single descent (Conty Estevez & Kulla 2018)",
+        resolve_single,
+        |name, scene, opts| tree_strategy(name, scene, opts, false, false),
+    )
+};
+
+/// `tree+bsdf`.
+pub const TREE_BSDF: Strategy = Strategy {
+    golden_variants: &["reproduce"],
+    ..Strategy::new(
+        "tree+bsdf",
+        "light tree single descent + BSDF sampling, MIS",
+        resolve_single,
+        |name, scene, opts| tree_strategy(name, scene, opts, false, true),
+    )
+};
+
+/// `tree-split`.
+pub const TREE_SPLIT: Strategy = Strategy {
+    knobs: SPLIT_KNOBS,
+    golden_variants: &["reproduce"],
+    ..Strategy::new(
+        "tree-split",
+        "light tree with adaptive splitting",
+        resolve_split,
+        |name, scene, opts| tree_strategy(name, scene, opts, true, false),
+    )
+};
+
+/// `tree-split+bsdf`: the paper's E&K baseline.
+pub const TREE_SPLIT_BSDF: Strategy = Strategy {
+    knobs: SPLIT_KNOBS,
+    golden_variants: &["reproduce"],
+    ..Strategy::new(
+        "tree-split+bsdf",
+        "adaptive tree splitting + BSDF sampling, MIS (the paper's E&K baseline)",
+        resolve_split,
+        |name, scene, opts| tree_strategy(name, scene, opts, true, true),
+    )
+};

@@ -231,6 +231,32 @@ where
         }
     }
 
+    /// The allocation diagnostics as the talk shows them: the BRDF-aware count N (black → blue
+    /// → green → yellow → white over 0..N_max) and the BO vs BRDF-sampling share (blue = BO,
+    /// red = BRDF sampling).
+    fn aux_colour(&self, channel: &str, v: f32) -> Option<Vec3> {
+        match channel {
+            "n_brdf_aware" => {
+                let stops = [
+                    Vec3::ZERO,
+                    Vec3::new(0.0, 0.1, 1.0),
+                    Vec3::new(0.0, 0.8, 0.1),
+                    Vec3::new(1.0, 0.9, 0.0),
+                    Vec3::ONE,
+                ];
+                let t = (v / self.config.n_max.max(1) as f32).clamp(0.0, 1.0)
+                    * (stops.len() - 1) as f32;
+                let i = (t as usize).min(stops.len() - 2);
+                Some(stops[i].lerp(stops[i + 1], t - i as f32))
+            }
+            "bo_share" => {
+                let s = v.clamp(0.0, 1.0);
+                Some(Vec3::new(1.0 - s, 0.0, s))
+            }
+            _ => None,
+        }
+    }
+
     fn begin_render(&self) {
         if let Some(l) = &self.learned {
             use crate::learned::Learner;

@@ -18,6 +18,7 @@ pub mod mis3;
 pub mod pivot_sphere;
 pub mod quad_importance;
 pub mod sg_importance;
+pub mod strategies;
 pub mod technique;
 pub mod three_techniques;
 

@@ -8,6 +8,7 @@ use crate::bsdf_sampling::sample_bsdf_at;
 use crate::light_strategy::{PickNumbers, Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
 use crate::mis::power_heuristic;
 use crate::scratch::Pooled;
+use crate::strategy::Strategy;
 use render_core::Vec3;
 use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, ShadingPoint};
 use render_core::rng::SampleStream;
@@ -135,3 +136,121 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
         self.selection.merge(pixel_memory);
     }
 }
+
+/// The learned options as the cluster strategies use them: their passes always weigh alike.
+pub(crate) fn cluster_learned(opts: &crate::StrategyOptions) -> super::LearnedConfig {
+    super::LearnedConfig {
+        pass_weights: super::PassWeights::Equal,
+        ..opts.learned
+    }
+}
+
+fn resolve_cluster(_: &str, opts: &crate::StrategyOptions) -> serde_json::Value {
+    serde_json::json!({
+        "power_units": crate::resolve::units(opts),
+        "cut": "breadth-first",
+        "learned": cluster_learned(opts),
+    })
+}
+
+fn resolve_descent(_: &str, opts: &crate::StrategyOptions) -> serde_json::Value {
+    serde_json::json!({
+        "power_units": crate::resolve::units(opts),
+        "max_levels": super::descent_table::LEVELS,
+        "max_pairs_per_region": super::descent_table::MAX_PAIRS,
+        "learned": opts.learned,
+    })
+}
+
+fn build_cluster(
+    name: &str,
+    scene: &Scene,
+    opts: &crate::StrategyOptions,
+) -> Result<Box<dyn DirectLighting>, crate::StrategyError> {
+    Ok(Box::new(LearnedStrategy {
+        name: name.into(),
+        selection: LearnedSelection::new(scene, opts.power_units(), opts.learned)
+            .map_err(crate::StrategyError::BadOption)?,
+        with_bsdf: name == LEARNED_BSDF.name,
+        light_samples: opts.learned.light_samples,
+        pass_weights: super::PassWeights::Equal,
+    }))
+}
+
+fn build_descent(
+    name: &str,
+    scene: &Scene,
+    opts: &crate::StrategyOptions,
+) -> Result<Box<dyn DirectLighting>, crate::StrategyError> {
+    Ok(Box::new(LearnedStrategy {
+        name: name.into(),
+        selection: super::descent::DescentSelection::new(scene, opts.power_units(), opts.learned)
+            .map_err(crate::StrategyError::BadOption)?,
+        with_bsdf: name == LEARNED_DESCENT_BSDF.name,
+        light_samples: opts.learned.light_samples,
+        pass_weights: opts.learned.pass_weights,
+    }))
+}
+
+/// The knobs of the learned cluster strategies.
+const CLUSTER_STRATEGY_KNOBS: &[&str] = &[
+    "learned-target",
+    "learned-clusters",
+    "learned-cells",
+    "learned-defensive",
+    "learned-prior",
+    "learned-samples",
+];
+const DESCENT_KNOBS: &[&str] = &[
+    "learned-cells",
+    "learned-defensive",
+    "learned-prior",
+    "learned-samples",
+    "learned-pass-weights",
+];
+
+/// `learned`.
+pub const LEARNED: Strategy = Strategy {
+    knobs: CLUSTER_STRATEGY_KNOBS,
+    golden_variants: &["learned-visibility"],
+    ..Strategy::new(
+        "learned",
+        "learned cluster selection (issue 25): a fixed 32-cluster cut, each cluster weighed by the tree importance × its contribution (or visibility) learnt per region in earlier passes (+20 % the tree importance alone), then the tree's descent",
+        resolve_cluster,
+        build_cluster,
+    )
+};
+
+/// `learned+bsdf`.
+pub const LEARNED_BSDF: Strategy = Strategy {
+    knobs: CLUSTER_STRATEGY_KNOBS,
+    golden_variants: &["learned-visibility"],
+    ..Strategy::new(
+        "learned+bsdf",
+        "learned + BSDF sampling, MIS",
+        resolve_cluster,
+        build_cluster,
+    )
+};
+
+/// `learned-descent`.
+pub const LEARNED_DESCENT: Strategy = Strategy {
+    knobs: DESCENT_KNOBS,
+    ..Strategy::new(
+        "learned-descent",
+        "learned descent (issue 25): the tree's descent with a factor per node of its top levels (all of them up to 4,096 sibling pairs per region), its contribution over its importance learnt per region in earlier passes (+20 % the plain descent)",
+        resolve_descent,
+        build_descent,
+    )
+};
+
+/// `learned-descent+bsdf`.
+pub const LEARNED_DESCENT_BSDF: Strategy = Strategy {
+    knobs: DESCENT_KNOBS,
+    ..Strategy::new(
+        "learned-descent+bsdf",
+        "learned-descent + BSDF sampling, MIS",
+        resolve_descent,
+        build_descent,
+    )
+};

@@ -30,6 +30,7 @@ use crate::brdf_oriented::technique::BoState;
 use crate::bsdf_sampling::sample_bsdf;
 use crate::mis::power2;
 use crate::scratch::Pooled;
+use crate::strategy::Strategy;
 use brdf_integrals::CapIntegral;
 use light_tree::LightTree;
 use render_core::Vec3;
@@ -202,3 +203,93 @@ where
         l
     }
 }
+
+/// Candidate count of a `ris` strategy name: `ris` (8), `ris-N` (1 ≤ N ≤ 1024), `ris-adaptive`.
+pub fn ris_count(name: &str) -> Option<CandidateCount> {
+    match name {
+        "ris" => Some(CandidateCount::Fixed(8)),
+        "ris-adaptive" => Some(CandidateCount::Adaptive { min: 4, max: 32 }),
+        _ => {
+            let m: u32 = name.strip_prefix("ris-")?.parse().ok()?;
+            (1..=1024).contains(&m).then_some(CandidateCount::Fixed(m))
+        }
+    }
+}
+
+fn resolve_ris(name: &str, opts: &crate::StrategyOptions) -> serde_json::Value {
+    serde_json::json!({
+        "candidates": ris_count(name),
+        "delta": opts.delta,
+        "max_cut": opts.max_cut,
+        "power_units": crate::resolve::units(opts),
+        // RIS builds its integral with the default options, `reproduce` or not.
+        "integral": crate::resolve::integral(&crate::StrategyOptions {
+            reproduce: false,
+            ..opts.clone()
+        }),
+    })
+}
+
+/// The RIS strategies; the BO candidates use the BO cut of `mis3` with its options.
+fn build_ris(
+    name: &str,
+    scene: &Scene,
+    opts: &crate::StrategyOptions,
+) -> Result<Box<dyn DirectLighting>, crate::StrategyError> {
+    use crate::brdf_oriented::BrdfIntegral;
+    use crate::tree_selection::{TreeMode, TreeSelection};
+    let count = ris_count(name)
+        .ok_or_else(|| crate::StrategyError::BadOption(format!("`{name}`: no candidate count")))?;
+    let tree = TreeSelection::new(scene, TreeMode::Single, opts.power_units())
+        .map_err(crate::StrategyError::BadOption)?
+        .tree;
+    Ok(match opts.brdf_integral {
+        BrdfIntegral::Sptd => Box::new(Ris {
+            name: name.into(),
+            tree,
+            integral: brdf_integrals::Sptd::default(),
+            count,
+            delta: opts.delta,
+            max_cut: opts.max_cut,
+        }),
+        BrdfIntegral::Ltc => Box::new(Ris {
+            name: name.into(),
+            tree,
+            integral: brdf_integrals::Ltc::default(),
+            count,
+            delta: opts.delta,
+            max_cut: opts.max_cut,
+        }),
+    })
+}
+
+const RIS_KNOBS: &[&str] = &["delta", "max-cut", "brdf-integral"];
+
+/// A RIS strategy value.
+const fn ris(name: &'static str, description: &'static str) -> Strategy {
+    Strategy {
+        knobs: RIS_KNOBS,
+        ..Strategy::new(name, description, resolve_ris, build_ris)
+    }
+}
+
+/// `ris`, and every `ris-N`.
+pub const RIS: Strategy = Strategy {
+    other_names: Some(|name| name.starts_with("ris-") && ris_count(name).is_some()),
+    ..ris(
+        "ris",
+        "resampled importance sampling: 8 light-tree + BO candidates, one kept, + BSDF sampling, MIS (ris-N: N candidates)",
+    )
+};
+/// `ris-4`.
+pub const RIS_4: Strategy = ris("ris-4", "ris with 4 candidates");
+/// `ris-32`.
+pub const RIS_32: Strategy = ris("ris-32", "ris with 32 candidates");
+/// `ris-adaptive`.
+pub const RIS_ADAPTIVE: Strategy = Strategy {
+    golden_variants: &["ltc", "pivot-independent"],
+    ..ris(
+        "ris-adaptive",
+        "ris with 4 + round(28·UB) candidates (UB of the BO cut, the paper's heuristic 1)",
+    )
+};

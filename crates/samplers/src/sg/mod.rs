@@ -13,3 +13,48 @@ pub mod selection;
 
 pub use importance::SgShading;
 pub use selection::{SgTreeSelection, sg_emitters};
+
+use crate::light_strategy::LightStrategy;
+use crate::strategy::Strategy;
+use crate::{StrategyError, StrategyOptions, resolve};
+
+fn resolve_sg(_: &str, opts: &StrategyOptions) -> serde_json::Value {
+    serde_json::json!({
+        "tree": "single, spherical-Gaussian importance",
+        "power_units": resolve::units(opts),
+        "floor": importance::FLOOR,
+    })
+}
+
+fn build_sg(
+    name: &str,
+    scene: &render_core::scene::Scene,
+    opts: &StrategyOptions,
+) -> Result<Box<dyn render_core::estimator::DirectLighting>, StrategyError> {
+    Ok(Box::new(LightStrategy {
+        name: name.into(),
+        selection: SgTreeSelection::new(scene, opts.power_units())
+            .map_err(StrategyError::BadOption)?,
+        with_bsdf: name == SG_TREE_BSDF.name,
+        parameters: serde_json::json!({
+            "reproduce": opts.reproduce,
+            "floor": importance::FLOOR,
+        }),
+    }))
+}
+
+/// `sg-tree`.
+pub const SG_TREE: Strategy = Strategy::new(
+    "sg-tree",
+    "light tree, single descent by spherical-Gaussian BRDF-aware importance (Tokuyoshi et al. 2024)",
+    resolve_sg,
+    build_sg,
+);
+
+/// `sg-tree+bsdf`.
+pub const SG_TREE_BSDF: Strategy = Strategy::new(
+    "sg-tree+bsdf",
+    "sg-tree + BSDF sampling, MIS",
+    resolve_sg,
+    build_sg,
+);

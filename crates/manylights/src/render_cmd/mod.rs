@@ -1,7 +1,10 @@
 //! `manylights render`.
+mod knob_args;
+
 use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
+pub use knob_args::KnobArgs;
 use render_core::emission_rays::EmissionRays;
 use render_core::filter::PixelFilter;
 use render_core::output::{write_exr, write_json, write_mask_png, write_png};
@@ -9,8 +12,6 @@ use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
 use render_core::splat::Reconstruction;
 use samplers::StrategyOptions;
-use samplers::brdf_oriented::{BoImportance, BrdfIntegral};
-use samplers::learned::{LearnTarget, LearnedConfig, PassWeights};
 use std::path::{Path, PathBuf};
 
 #[derive(Args)]
@@ -23,6 +24,8 @@ pub struct RenderArgs {
     /// Samples per pixel (default 16; with --time-budget, the most to take, unlimited if not given).
     #[arg(long)]
     pub spp: Option<u32>,
+    /// Seed of every random number of the render: the same seed gives the same image, whatever
+    /// the thread count.
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// The pixel filter, `NAME[:RADIUS]`: box (radius 0.5 by default), triangle (2), gaussian
@@ -35,8 +38,10 @@ pub struct RenderArgs {
     /// pixel within the radius, which `--reproduce` implies).
     #[arg(long, value_parser = reconstruction_parser())]
     pub reconstruction: Option<Reconstruction>,
+    /// Image width in pixels (default: the camera's).
     #[arg(long)]
     pub width: Option<u32>,
+    /// Image height in pixels (default: the camera's).
     #[arg(long)]
     pub height: Option<u32>,
     /// Camera name (default: the scene's first camera).
@@ -60,14 +65,17 @@ pub struct RenderArgs {
     /// (fair equal-time comparisons on a machine shared with other jobs).
     #[arg(long, value_enum, default_value = "wall")]
     pub budget_clock: BudgetClockArg,
+    /// Worker threads (default: one per CPU). The image does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
     #[arg(long)]
     pub aux: bool,
-    /// Print ray throughput.
+    /// Print ray throughput, the CPU time per spp and the strategy's own counters per shading
+    /// point (e.g. the method's clusters and BRDF-aware samples).
     #[arg(long)]
     pub stats: bool,
+    /// No progress bar, scene-load warnings or summary line on stderr (errors are still printed).
     #[arg(long)]
     pub quiet: bool,
 }
@@ -76,6 +84,7 @@ pub struct RenderArgs {
 /// (`manylights strategy` takes the same flags and prints them resolved).
 #[derive(Args, Debug, Clone)]
 pub struct StrategyArgs {
+    /// The direct-lighting strategy (`manylights strategies` lists them).
     #[arg(long, default_value = "power+bsdf")]
     pub strategy: String,
     /// Where the samples' numbers come from: `independent` numbers per dimension,
@@ -87,40 +96,34 @@ pub struct StrategyArgs {
     pub sampler: Option<Sampler>,
     /// Camera rays per sample that gather the emission seen directly, at the pixels that may
     /// straddle a light's edge (every pixel in the first pass, then those near a light not yet
-    /// seen to be fully inside one): 1 (the default) traces only the sample's own ray; more
-    /// lowers the noise of a pixel's coverage of the lights, which light sampling never touches.
-    /// Needs the sampled reconstruction. [default: 16 for mis3-adaptive and mis3-adaptive-learned without --reproduce
-    /// (results/paper at bb1cfa3: over all pixels 3.68× E&K against 0.95× with 1), else 1]
+    /// seen to be fully inside one): 1 traces only the sample's own ray; more lowers the noise of
+    /// a pixel's coverage of the lights, which light sampling never touches. Needs the sampled
+    /// reconstruction. [default: the strategy's (`manylights strategies --json`): 16 for
+    /// mis3-adaptive and mis3-adaptive-learned, 1 for the others and under --reproduce]
     #[arg(long, value_parser = emission_rays_parser)]
     pub emission_rays: Option<u32>,
-    /// Adaptive tree splitting threshold τ (tree-split and mis3 strategies) [default: 0.35, the
-    /// authors' 0.85 with --reproduce].
-    #[arg(long)]
-    pub tau: Option<f32>,
-    /// Most clusters in an adaptive light cut (tree-split strategies; mis3: both cuts).
-    #[arg(long, default_value_t = StrategyOptions::default().max_cut)]
-    pub max_cut: usize,
     #[command(flatten)]
-    pub method: MethodArgs,
+    pub knobs: KnobArgs,
 }
 
 impl StrategyArgs {
-    pub fn options(&self) -> StrategyOptions {
-        self.method.options(self.tau, self.max_cut)
+    /// The registered strategy `--strategy` names.
+    pub fn strategy(&self) -> anyhow::Result<&'static samplers::Strategy> {
+        Ok(samplers::registry::find(&self.strategy)?)
     }
 
-    /// `--emission-rays`, or its default: [`METHOD_EMISSION_RAYS`] for our `mis3-adaptive`
-    /// (its few spp per pixel leave the coverage noise of pixels that see a light; the paper
-    /// experiment chose it) and for its learned variant, so that the two compare like with like;
-    /// one ray for every other strategy and for the authors' settings.
-    pub fn emission_rays(&self) -> u32 {
-        self.emission_rays.unwrap_or(
-            if self.strategy.starts_with("mis3-adaptive") && !self.method.reproduce {
-                METHOD_EMISSION_RAYS
-            } else {
-                1
-            },
-        )
+    /// The strategy's options: the defaults with the knob flags given applied; a flag the
+    /// strategy does not take is an error naming the ones it does.
+    pub fn options(&self) -> anyhow::Result<StrategyOptions> {
+        Ok(self.strategy()?.options(&self.knobs.given)?)
+    }
+
+    /// `--emission-rays`, or the strategy's default.
+    pub fn emission_rays(&self) -> anyhow::Result<u32> {
+        match self.emission_rays {
+            Some(k) => Ok(k),
+            None => Ok(self.strategy()?.default_emission_rays(&self.options()?)),
+        }
     }
 
     /// The strategy's name, every parameter it renders with (defaults filled in) and the
@@ -128,137 +131,20 @@ impl StrategyArgs {
     /// covered by its `scene_hash`): what the render's
     /// JSON records as `resolved_strategy`.
     pub fn resolved(&self) -> anyhow::Result<serde_json::Value> {
-        let parameters = samplers::resolve::resolved_parameters(&self.strategy, &self.options())?;
+        let parameters = samplers::resolve::resolved_parameters(&self.strategy, &self.options()?)?;
         Ok(serde_json::json!({
             "strategy": self.strategy,
             "parameters": parameters,
             "sampler": self.sampler.map(Sampler::name),
-            "emission_rays": self.emission_rays(),
+            "emission_rays": self.emission_rays()?,
         }))
     }
-}
-
-/// `mis3-adaptive`'s default `--emission-rays`.
-pub const METHOD_EMISSION_RAYS: u32 = 16;
-
-/// Knobs of the light-tree and Liu et al. 2019 strategies; their defaults are
-/// [`StrategyOptions::default`] (the authors' values).
-#[derive(Args, Debug, Clone)]
-pub struct MethodArgs {
-    /// BRDF-oriented cut: split a node whose cap integral of the glossy lobe exceeds δ.
-    #[arg(long, default_value_t = StrategyOptions::default().delta)]
-    pub delta: f32,
-    /// Most BRDF-aware samples beyond the forced two (N = floor(N_max·UB)); with the default
-    /// efficient N_max, its value for the first two passes.
-    #[arg(long, default_value_t = StrategyOptions::default().n_max)]
-    pub n_max: u32,
-    /// Weight of a BRDF-sampling hit in P(BO) = n_nohit / (n_nohit + λ·n_hit).
-    #[arg(long, default_value_t = StrategyOptions::default().lambda)]
-    pub lambda: f32,
-    /// Cap-integral approximation behind BRDF-oriented sampling.
-    #[arg(long, default_value_t = StrategyOptions::default().brdf_integral,
-          value_parser = brdf_integral_parser())]
-    pub brdf_integral: BrdfIntegral,
-    /// Node importance of BRDF-oriented sampling's cluster choice and descent: `cap` (I_BO from
-    /// the cap integrals, the paper) or `sg` (the spherical-Gaussian importance of sg-tree);
-    /// the BO cut and heuristic 1's UB use the cap integrals either way.
-    #[arg(long, default_value_t = StrategyOptions::default().bo_importance,
-          value_parser = bo_importance_parser())]
-    pub bo_importance: BoImportance,
-    /// The authors' code's behaviour: nearest SPTD lookup, Oat–Sander cap ∩ cap, glossy-only
-    /// importance, one rescaled random number per descent, in-sample (biased) allocation.
-    #[arg(long)]
-    pub reproduce: bool,
-    /// Sample points on sphere lights by the pivot-transformed lobe (mixed with cone sampling).
-    #[arg(long)]
-    pub pivot_sphere: bool,
-    /// Turn off heuristic 1 (N = floor(N_max·UB)); N = N_max/2 instead.
-    #[arg(long)]
-    pub no_adaptive_total: bool,
-    /// Turn off heuristic 2 (P(BO) from hits and misses); P(BO) = 1/2 instead.
-    #[arg(long)]
-    pub no_adaptive_split: bool,
-    /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo).
-    #[arg(long)]
-    pub weighted_ub: bool,
-    /// Keep N_max constant (the paper's heuristic 1) instead of choosing it after each pass by
-    /// variance × cost from the samples so far (--reproduce implies it).
-    #[arg(long)]
-    pub fixed_n_max: bool,
-    /// mis3-adaptive: draw a shading point's BRDF-aware samples independently instead of as
-    /// one stratified set per technique.
-    #[arg(long)]
-    pub independent_samples: bool,
-    /// mis3 strategies: keep the E&K cut (one light per cluster) for LS at glossy points, as the
-    /// paper, instead of one descent there (--reproduce implies it).
-    #[arg(long)]
-    pub split_ls_at_glossy: bool,
-    /// mis3 strategies and RIS: BO descends below its cut one binary level at a time, as the
-    /// paper, instead of the tree's four-wide descent (--reproduce implies it).
-    #[arg(long)]
-    pub binary_bo_descent: bool,
-    /// mis3-adaptive: no pilot; N_max stays --n-max until two passes are done, then is learnt
-    /// (the pilot, one pixel in 16 with two samples before the first pass, learns it at once).
-    #[arg(long)]
-    pub no_pilot: bool,
-    /// Learned selection: what a region learns of each cluster, `contribution` (its observed
-    /// contribution over its prior) or `visibility` (its shadow rays' hit rate).
-    #[arg(long, default_value = LearnedConfig::default().target.name(),
-          value_parser = learn_target_parser())]
-    pub learned_target: LearnTarget,
-    /// Learned selection: clusters of its fixed cut (1–256).
-    #[arg(long, default_value_t = LearnedConfig::default().clusters)]
-    pub learned_clusters: usize,
-    /// Learned selection: region cells per scene diagonal.
-    #[arg(long, default_value_t = LearnedConfig::default().cells_per_diagonal)]
-    pub learned_cells: f32,
-    /// Learned selection: share of the unlearnt prior in its pmf, in (0, 1].
-    #[arg(long, default_value_t = LearnedConfig::default().defensive)]
-    pub learned_defensive: f32,
-    /// `learned`, `learned+bsdf`: light samples per shading point (beside one BSDF sample).
-    #[arg(long, default_value_t = LearnedConfig::default().light_samples)]
-    pub learned_samples: u32,
-    /// Learned selection: the prior's strength a, in rays (what a cluster or node not yet
-    /// observed in a region keeps, and how fast its observations take over).
-    #[arg(long, default_value_t = LearnedConfig::default().prior_strength)]
-    pub learned_prior: f32,
-    /// `learned-descent`: how its passes are weighed in each pixel's average, `sqrt` (pass i
-    /// by √i: the later, better-learnt passes count more; unbiased) or `equal`.
-    #[arg(long, default_value = LearnedConfig::default().pass_weights.name(),
-          value_parser = pass_weights_parser())]
-    pub learned_pass_weights: PassWeights,
-}
-
-/// `--learned-target`: the names of [`LearnTarget`], listed in `--help`.
-fn learn_target_parser() -> impl clap::builder::TypedValueParser<Value = LearnTarget> {
-    use clap::builder::{PossibleValuesParser, TypedValueParser};
-    PossibleValuesParser::new(LearnTarget::ALL.map(LearnTarget::name))
-        .map(|s| LearnTarget::from_name(&s).expect("a listed name"))
-}
-
-/// `--learned-pass-weights`: the names of [`PassWeights`], listed in `--help`.
-fn pass_weights_parser() -> impl clap::builder::TypedValueParser<Value = PassWeights> {
-    use clap::builder::{PossibleValuesParser, TypedValueParser};
-    PossibleValuesParser::new(PassWeights::ALL.map(PassWeights::name))
-        .map(|s| PassWeights::from_name(&s).expect("a listed name"))
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
 pub enum BudgetClockArg {
     Wall,
     Cpu,
-}
-
-/// `--brdf-integral`: the names of [`BrdfIntegral`], listed in `--help`.
-fn brdf_integral_parser() -> impl clap::builder::TypedValueParser<Value = BrdfIntegral> {
-    use clap::builder::{PossibleValuesParser, TypedValueParser};
-    PossibleValuesParser::new(BrdfIntegral::ALL.map(BrdfIntegral::name)).try_map(|s| s.parse())
-}
-
-/// `--bo-importance`: the names of [`BoImportance`], listed in `--help`.
-fn bo_importance_parser() -> impl clap::builder::TypedValueParser<Value = BoImportance> {
-    use clap::builder::{PossibleValuesParser, TypedValueParser};
-    PossibleValuesParser::new(BoImportance::ALL.map(BoImportance::name)).try_map(|s| s.parse())
 }
 
 /// The sampler a render uses, and why: `--sampler`, else the scene file's, else pbrt-v3's
@@ -313,66 +199,6 @@ fn sampler_parser() -> impl clap::builder::TypedValueParser<Value = Sampler> {
         .map(|s| Sampler::from_name(&s).expect("a listed name"))
 }
 
-impl MethodArgs {
-    pub fn options(&self, tau: Option<f32>, max_cut: usize) -> StrategyOptions {
-        StrategyOptions {
-            tau,
-            max_cut,
-            delta: self.delta,
-            n_max: self.n_max,
-            lambda: self.lambda,
-            brdf_integral: self.brdf_integral,
-            bo_importance: self.bo_importance,
-            reproduce: self.reproduce,
-            pivot_sphere: self.pivot_sphere,
-            adaptive_total: !self.no_adaptive_total,
-            adaptive_split: !self.no_adaptive_split,
-            weighted_ub: self.weighted_ub,
-            efficient_total: !self.fixed_n_max,
-            stratified: !self.independent_samples,
-            split_ls_at_glossy: self.split_ls_at_glossy,
-            binary_bo_descent: self.binary_bo_descent,
-            pilot: !self.no_pilot,
-            learned: LearnedConfig {
-                target: self.learned_target,
-                clusters: self.learned_clusters,
-                cells_per_diagonal: self.learned_cells,
-                defensive: self.learned_defensive,
-                light_samples: self.learned_samples,
-                prior_strength: self.learned_prior,
-                pass_weights: self.learned_pass_weights,
-                ..LearnedConfig::default()
-            },
-        }
-    }
-}
-
-/// False-colour PNGs of the allocation diagnostics, as the talk shows them: the BRDF-aware
-/// count N (black → blue → green → yellow → white over 0..N_max) and the BO vs BRDF-sampling
-/// share (blue = BO, red = BRDF sampling).
-fn false_colour(name: &str, v: f32, n_max: u32) -> Option<glam::Vec3> {
-    use glam::Vec3;
-    match name {
-        "n_brdf_aware" => {
-            let stops = [
-                Vec3::ZERO,
-                Vec3::new(0.0, 0.1, 1.0),
-                Vec3::new(0.0, 0.8, 0.1),
-                Vec3::new(1.0, 0.9, 0.0),
-                Vec3::ONE,
-            ];
-            let t = (v / n_max.max(1) as f32).clamp(0.0, 1.0) * (stops.len() - 1) as f32;
-            let i = (t as usize).min(stops.len() - 2);
-            Some(stops[i].lerp(stops[i + 1], t - i as f32))
-        }
-        "bo_share" => {
-            let s = v.clamp(0.0, 1.0);
-            Some(Vec3::new(1.0 - s, 0.0, s))
-        }
-        _ => None,
-    }
-}
-
 fn sibling(out: &Path, suffix: &str) -> PathBuf {
     let stem = out
         .file_stem()
@@ -422,7 +248,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("warning: {w}");
         }
     }
-    let opts = args.strategy.options();
+    let opts = args.strategy.options()?;
+    let emission_rays = args.strategy.emission_rays()?;
     let resolved = args.strategy.resolved()?;
     let (sampler, sampler_from) = choose_sampler(args.strategy.sampler, &scene, opts.reproduce);
     let (filter, filter_from) = match (&args.filter, &scene.render_hints.filter) {
@@ -468,14 +295,13 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         sampler,
         filter: filter.clone(),
         reconstruction,
-        emission_rays: EmissionRays::new(args.strategy.emission_rays())
-            .map_err(anyhow::Error::msg)?,
+        emission_rays: EmissionRays::new(emission_rays).map_err(anyhow::Error::msg)?,
     };
     if settings.emission_rays != EmissionRays::OFF && reconstruction == Reconstruction::Splat {
         bail!(
             "--emission-rays {} ({}) needs the sampled reconstruction, but {reconstruction_from} \
              chose splatting: add --reconstruction sampled, or --emission-rays 1",
-            args.strategy.emission_rays(),
+            emission_rays,
             if args.strategy.emission_rays.is_some() {
                 "the flag"
             } else {
@@ -528,7 +354,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             aux_files.push(exr);
             let colours: Option<Vec<glam::Vec3>> = values
                 .iter()
-                .map(|&v| false_colour(name, v, opts.n_max))
+                .map(|&v| strategy.aux_colour(name, v))
                 .collect();
             if let Some(colours) = colours {
                 let png = sibling(&args.out, &format!(".{name}.png"));
@@ -570,7 +396,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             "reconstruction": reconstruction.name(),
             "reconstruction_from": reconstruction_from,
         },
-        "emission_rays": args.strategy.emission_rays(),
+        "emission_rays": emission_rays,
         "width": width,
         "height": height,
         "camera": camera,
