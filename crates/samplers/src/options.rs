@@ -36,7 +36,7 @@ pub struct StrategyOptions {
     /// Heuristic 1: N = floor(N_max·UB); off: N = N_max/2.
     pub adaptive_total: bool,
     /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo), so that N follows the
-    /// lobe's actual strength (off by default: see README, "weighted UB").
+    /// lobe's actual strength (off by default: see docs/notes/ablations.md, "weighted UB").
     pub weighted_ub: bool,
     /// Heuristic 1's N_max chosen after each pass, from the render's samples so far, by
     /// variance × cost ([`brdf_oriented::allocation::EfficiencyTally`]); off (and always under

@@ -101,7 +101,7 @@ crate::scratch_pool!(TreeScratch, |s| {
 /// The picks and pmf replays descend the tree's eight-wide octs
 /// ([`LightTree::sample_from`] / [`LightTree::pmf_from`]), one evaluation per three levels. No memo
 /// by default: on `builtin:emissive-mesh` only 338 of 9,724 shading points of `tree+bsdf`
-/// replayed a pmf (callgrind, docs/light-tree.md), so its lookups cost more than they saved.
+/// replayed a pmf (callgrind, docs/notes/light-tree.md), so its lookups cost more than they saved.
 /// The method replays one per BRDF-aware sample and asks for the memo
 /// ([`TreeState::with_cached_pmf`]).
 pub struct TreeState {

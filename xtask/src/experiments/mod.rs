@@ -1,6 +1,6 @@
 //! `cargo xtask run-experiments` and `cargo xtask merge-results`: scenes × strategies × spp /
 //! time budgets × seeds against cached high-spp references; tables, plots and strips in
-//! `results/<experiment>/`. See xtask/README.md.
+//! `results/<experiment>/`. See docs/experiments.md.
 pub mod charts;
 pub mod compositing;
 pub mod config;

@@ -76,7 +76,7 @@ pub struct Validity {
 pub struct Manifest {
     pub identity: Identity,
     pub validity: Validity,
-    /// Recorded, not checked: references stay valid across commits (see README).
+    /// Recorded, not checked: references stay valid across commits (see references/README.md).
     pub git_commit: Option<String>,
     pub created_unix: u64,
     /// Wall seconds of the two halves together.

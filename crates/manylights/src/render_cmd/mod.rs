@@ -161,7 +161,7 @@ fn choose_sampler(
         // The samplers experiment (results/samplers, rerun at c353c0d): at equal time pbrt-v3's
         // lowdiscrepancy beat independent numbers by 1.33× (MIS adaptive) and 1.08× (E&K) in
         // geometric mean, Sobol by 1.21× / 1.03× (the run at ef738dd had them level and chose
-        // Sobol); docs/samplers.md.
+        // Sobol); docs/notes/samplers.md.
         (None, None) => (Sampler::LowDiscrepancy, "default"),
     }
 }

@@ -628,7 +628,7 @@ fn record_efficiency<L: LobeIntegral + LobeDensity>(
     let (n_bo, n_brdf) = (counts.n_bo, counts.n_brdf);
     // In units of one BRDF-aware sample (a ray, a descent, the other techniques' densities),
     // the rest costs about two for the camera ray and shading, one per LS cluster and a
-    // quarter per BO cluster (measured: ARCHITECTURE.md, "N_max chosen by variance × cost").
+    // quarter per BO cluster (measured: docs/notes/defaults.md).
     let (ls_clusters, bo_clusters) = point.cluster_counts();
     let rest_cost = 2.0 + ls_clusters as f32 + 0.25 * bo_clusters as f32;
     let glossy = point.bo.as_ref().map(|b| {

@@ -6,7 +6,7 @@
 //! * [`resample`]: choosing one candidate in proportion to its resampling weight.
 //! * [`strategy`]: the strategies `ris`, `ris-N`, `ris-adaptive`: M candidates weighted by
 //!   unshadowed f·L·G over their source density, one kept and shadow-tested, combined with BSDF
-//!   sampling by MIS (the argument for unbiasedness is in [`strategy`] and ARCHITECTURE.md).
+//!   sampling by MIS (the argument for unbiasedness is in [`strategy`] and docs/method.md).
 pub mod candidates;
 pub mod resample;
 pub mod strategy;

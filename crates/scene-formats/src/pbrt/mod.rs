@@ -6,7 +6,7 @@
 //! * [`shapes`], [`ply`]: meshes; [`materials`]: materials and constant textures.
 //!
 //! Unsupported features are warnings naming the file and line; input we cannot render is an
-//! error with file and line. The README's "your own scene" section maps every directive.
+//! error with file and line. docs/scenes.md maps every directive.
 pub mod materials;
 pub mod params;
 pub mod parser;
