@@ -35,6 +35,7 @@ pub mod point_sets;
 pub mod registry;
 pub mod resolve;
 pub mod ris;
+pub mod rivals;
 mod scratch;
 pub mod selection;
 pub mod sg;

@@ -1,0 +1,6 @@
+//! The field's light-tree rivals beside the paper's method (issue 50), each on our light tree
+//! and with our light-point sampling, BSDF sampling and MIS helpers:
+//!
+//! * [`slc`]: stochastic lightcuts (Yuksel, HPG 2019): a cut of at most K nodes refined by
+//!   an error bound, one light per cut node drawn down its subtree, one shadow ray each.
+pub mod slc;
