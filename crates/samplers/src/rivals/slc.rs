@@ -1,5 +1,6 @@
 //! Stochastic lightcuts (Yuksel, HPG 2019; real-time form Lin & Yuksel, I3D 2020): strategies
-//! `slc` (lights only) and `slc+bsdf` (with one BSDF sample, combined by MIS).
+//! `slc` (lights only) and `slc+bsdf` (with one BSDF sample, combined by MIS); `slc-bo+bsdf`,
+//! the descent weighed by the BRDF-oriented importance at glossy points, is in [`super::slc_bo`].
 //!
 //! # The estimator at a shading point x (receiver normal n)
 //!
@@ -83,10 +84,12 @@
 //! weight 1, which is right because no light sample covers it. Delta lights cannot be hit, so
 //! their light samples keep weight 1. [`LightStrategy`] computes exactly these weights,
 //! because a selection's `pmf` is the pick's probability within its part.
+use super::slc_bo::BoWeight;
 use crate::light_strategy::LightStrategy;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use crate::tree_selection::{PowerUnits, light_bounds};
+use brdf_integrals::Sptd;
 use light_tree::{Cut, LightTree, MIN_DIST_SQ, Node, NodeId, Rescaled};
 use render_core::Vec3;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
@@ -156,7 +159,7 @@ pub fn cut_into(
 ) {
     out.nodes.clear();
     heap.clear();
-    let mut place = |id: NodeId, out: &mut Cut, heap: &mut BinaryHeap<Candidate>| {
+    let place = |id: NodeId, out: &mut Cut, heap: &mut BinaryHeap<Candidate>| {
         let node = tree.node(id);
         let bound = if node.is_leaf() {
             0.0
@@ -193,6 +196,8 @@ pub struct SlcSelection {
     pub cut_size: usize,
     /// Squared floor of the box distance in the error bound, in scene units².
     floor_sq: f32,
+    /// The cap integrals of `slc-bo`'s descent at glossy points (None: the tree's descent).
+    bo: Option<Sptd>,
 }
 
 impl SlcSelection {
@@ -211,7 +216,15 @@ impl SlcSelection {
             tree,
             cut_size,
             floor_sq: (floor * floor).max(MIN_DIST_SQ),
+            bo: None,
         })
+    }
+
+    /// The same selection descending by the BRDF-oriented weight at glossy points when `bo`
+    /// ([`super::slc_bo`]).
+    pub fn with_bo(mut self, bo: bool) -> Self {
+        self.bo = bo.then(Sptd::default);
+        self
     }
 
     /// The cut at (`x`, `n`) (empty without lights), for tests and tools.
@@ -252,6 +265,8 @@ pub struct SlcState {
     scratch: Option<Pooled<SlcScratch>>,
     x: Vec3,
     n: Vec3,
+    /// `slc-bo`'s node weight at a glossy point.
+    bo: Option<BoWeight>,
 }
 
 impl SlcState {
@@ -272,7 +287,11 @@ impl LightSelection for SlcSelection {
             cut_into(tree, (x, n), self.cut_size, self.floor_sq, cut, heap);
             s
         });
-        SlcState { scratch, x, n }
+        let bo = self
+            .bo
+            .as_ref()
+            .and_then(|integral| BoWeight::at(sp, integral));
+        SlcState { scratch, x, n, bo }
     }
 
     fn clusters(&self, state: &SlcState) -> usize {
@@ -289,6 +308,16 @@ impl LightSelection for SlcSelection {
         let (Some(tree), Some(cut)) = (&self.tree, state.cut()) else {
             return;
         };
+        if let Some(bo) = &state.bo {
+            let weight = |id| bo.weight(tree.node(id));
+            for &node in &cut.nodes {
+                let mut u = Rescaled(rng.next_u64());
+                if let Some((light, pmf)) = tree.sample_subtree(node, weight, &mut u) {
+                    picks.push((light as u32, pmf));
+                }
+            }
+            return;
+        }
         let (x, n) = (state.x, state.n);
         // One fresh number per cut node, in cut order; two descents side by side.
         let mut pairs = cut.nodes.chunks_exact(2);
@@ -313,9 +342,13 @@ impl LightSelection for SlcSelection {
         let (Some(tree), Some(cut)) = (&self.tree, state.cut()) else {
             return 0.0;
         };
-        match cut.cluster_of(tree, light as usize) {
-            Some(k) => tree.pmf_from(cut.nodes[k], state.x, state.n, light as usize),
-            None => 0.0,
+        let light = light as usize;
+        let Some(k) = cut.cluster_of(tree, light) else {
+            return 0.0;
+        };
+        match &state.bo {
+            Some(bo) => tree.pmf_subtree(cut.nodes[k], |id| bo.weight(tree.node(id)), light),
+            None => tree.pmf_from(cut.nodes[k], state.x, state.n, light),
         }
     }
 }
@@ -327,30 +360,39 @@ pub struct SlcConfig {
     pub cut_size: usize,
     /// Add one BSDF sample, combined by the power heuristic (`slc+bsdf`).
     pub with_bsdf: bool,
+    /// At glossy points, descend by the BRDF-oriented weight (`slc-bo+bsdf`, [`super::slc_bo`]).
+    pub bo: bool,
     /// The tree's power units (the authors' `LeWithArea` under `--reproduce`, as every tree
     /// strategy).
     pub units: PowerUnits,
 }
 
 impl SlcConfig {
-    /// The configuration of strategy `name` (`slc`, `slc+bsdf`) under `opts`, with the
+    /// The configuration of strategy `name` (`slc`, `slc+bsdf`, `slc-bo+bsdf`) under `opts`, with the
     /// paper's K = [`DEFAULT_CUT_SIZE`] (`opts.max_cut` is the E&K cut's, 64 by default).
     pub fn for_name(name: &str, opts: &crate::StrategyOptions) -> Result<SlcConfig, String> {
-        let with_bsdf = match name {
-            "slc" => false,
-            "slc+bsdf" => true,
+        let (with_bsdf, bo) = match name {
+            "slc" => (false, false),
+            "slc+bsdf" => (true, false),
+            "slc-bo+bsdf" => (true, true),
             other => return Err(format!("not a stochastic-lightcuts strategy: `{other}`")),
         };
         Ok(SlcConfig {
             cut_size: DEFAULT_CUT_SIZE,
             with_bsdf,
+            bo,
             units: opts.power_units(),
         })
     }
 
     /// The strategy's name.
     pub fn name(&self) -> &'static str {
-        if self.with_bsdf { "slc+bsdf" } else { "slc" }
+        match (self.bo, self.with_bsdf) {
+            (true, true) => "slc-bo+bsdf",
+            (true, false) => "slc-bo",
+            (false, true) => "slc+bsdf",
+            (false, false) => "slc",
+        }
     }
 }
 
@@ -361,6 +403,12 @@ pub fn resolved_parameters(config: &SlcConfig) -> serde_json::Value {
         "error_bound": "power x emitter and receiver cone cosines / max(box distance, floor)^2",
         "distance_floor": DISTANCE_FLOOR,
         "descent": "tree importance (E&K)",
+        "glossy_descent": config.bo.then(|| {
+            format!(
+                "I_BO (SPTD, diffuse term) + {} x (ks + kd)/pi x E&K importance",
+                super::slc_bo::EK_FLOOR
+            )
+        }),
         "power_units": match config.units {
             PowerUnits::Watts => "watts",
             PowerUnits::Authors => "authors",
@@ -378,7 +426,7 @@ impl Slc {
     pub fn new(scene: &Scene, config: SlcConfig) -> Result<Slc, String> {
         Ok(Slc(LightStrategy {
             name: config.name().into(),
-            selection: SlcSelection::new(scene, config.cut_size, config.units)?,
+            selection: SlcSelection::new(scene, config.cut_size, config.units)?.with_bo(config.bo),
             with_bsdf: config.with_bsdf,
             parameters: resolved_parameters(&config),
         }))
