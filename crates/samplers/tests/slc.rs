@@ -11,7 +11,7 @@ use render_core::scene::Scene;
 use samplers::StrategyOptions;
 use samplers::convergence::compare;
 use samplers::light_strategy::LightStrategy;
-use samplers::rivals::slc::{self, DEFAULT_CUT_SIZE, Slc, SlcConfig, SlcSelection};
+use samplers::rivals::slc::{self, DEFAULT_CUT_SIZE, Slc, SlcConfig, SlcDescent, SlcSelection};
 use samplers::selection::LightSelection;
 use samplers::tree_selection::{PowerUnits, TreeMode, TreeSelection, TreeState};
 
@@ -20,6 +20,7 @@ fn config(with_bsdf: bool, cut_size: usize) -> SlcConfig {
         cut_size,
         with_bsdf,
         bo: false,
+        descent: SlcDescent::Tree,
         units: PowerUnits::Watts,
     }
 }
@@ -32,10 +33,23 @@ fn bo_config(cut_size: usize) -> SlcConfig {
     }
 }
 
-/// The selection of `slc` and of `slc-bo` with cuts of at most `k` nodes.
-fn selections(scene: &Scene, k: usize) -> [(&'static str, SlcSelection); 2] {
+/// `slc+bsdf` with Lin & Yuksel's min-max descent.
+fn minmax_config(cut_size: usize) -> SlcConfig {
+    SlcConfig {
+        descent: SlcDescent::MinMax,
+        ..config(true, cut_size)
+    }
+}
+
+/// The selection of `slc`, of `slc-bo` and of `slc` with the min-max descent, with cuts of at
+/// most `k` nodes.
+fn selections(scene: &Scene, k: usize) -> [(&'static str, SlcSelection); 3] {
     let plain = || SlcSelection::new(scene, k, PowerUnits::Watts).unwrap();
-    [("slc", plain()), ("slc-bo", plain().with_bo(true))]
+    [
+        ("slc", plain()),
+        ("slc-bo", plain().with_bo(true)),
+        ("slc min-max", plain().with_descent(SlcDescent::MinMax)),
+    ]
 }
 
 /// Shading points on the mixed scene's glossy floor, metal panel and diffuse panel.
@@ -218,7 +232,7 @@ fn the_pmf_at_sampling_equals_a_later_replay() {
 #[test]
 fn the_bo_descent_differs_at_glossy_points_only() {
     let scene = common::mixed_scene(200);
-    let [(_, plain), (_, bo)] = selections(&scene, 4);
+    let [(_, plain), (_, bo), _] = selections(&scene, 4);
     let (mut glossy, mut differ) = (0, 0);
     for sp in shading_points(&scene) {
         let (a, b) = (plain.prepare(&scene, &sp), bo.prepare(&scene, &sp));
@@ -260,12 +274,13 @@ fn slc_converges_to_the_image_of_power_bsdf() {
         config(false, k),
         config(true, 4),
         bo_config(4),
+        minmax_config(4),
         config(false, 4),
     ];
     // The reference at 1,024 spp: at 256 the metal panel's small-sphere highlights (a heavy
     // tail for every strategy) left its top-left quarter 5 of its own SE low.
     for (scene, ref_spp, spp, size, variants) in [
-        (&mixed, 1024, 64, None, &all[..5]),
+        (&mixed, 1024, 64, None, &all[..6]),
         (&spheres, 512, 32, Some((32, 24)), &all[..]),
     ] {
         let reference = power_bsdf(scene, ref_spp, size);
@@ -311,7 +326,7 @@ fn point_lights_keep_a_pmf_and_the_image_agrees() {
         .filter(|&l| scene.lights[l as usize].is_delta())
         .collect();
     assert_eq!(points.len(), 6);
-    let [_, (_, bo)] = selections(&scene, 4);
+    let [_, (_, bo), _] = selections(&scene, 4);
     let mut glossy = 0;
     for sp in shading_points(&scene) {
         if sp.bsdf.is_pure_diffuse() {
@@ -330,7 +345,12 @@ fn point_lights_keep_a_pmf_and_the_image_agrees() {
     }
     assert!(glossy >= 2);
     let reference = power_bsdf(&scene, 1024, None);
-    for c in [bo_config(DEFAULT_CUT_SIZE), bo_config(4), config(true, 4)] {
+    for c in [
+        bo_config(DEFAULT_CUT_SIZE),
+        bo_config(4),
+        config(true, 4),
+        minmax_config(4),
+    ] {
         let strategy = Slc::new(&scene, c).unwrap();
         let r = render_with(&scene, &strategy, 64, (2, 2), None);
         let failures = compare(&reference, &r, 2, 3.0);
@@ -400,7 +420,12 @@ fn a_dropped_pmf_is_caught_by_the_agreement_check() {
 #[test]
 fn slc_image_is_identical_for_any_thread_count() {
     let scene = common::mixed_scene(10);
-    for c in [config(false, 4), config(true, 4), bo_config(4)] {
+    for c in [
+        config(false, 4),
+        config(true, 4),
+        bo_config(4),
+        minmax_config(4),
+    ] {
         let strategy = Slc::new(&scene, c).unwrap();
         let a = render_with(&scene, &strategy, 2, (1, 7), None);
         let b = render_with(&scene, &strategy, 2, (2, 7), None);
@@ -425,6 +450,8 @@ fn config_names_and_parameters() {
     assert!(slc::resolved_parameters(&bo)["glossy_descent"].is_string());
     assert!(SlcConfig::for_name("slc-nope", &opts).is_err());
     let p = slc::resolved_parameters(&c);
+    let minmax = slc::resolved_parameters(&minmax_config(4));
+    assert_ne!(minmax["descent"], p["descent"]);
     assert_eq!(p["cut_size"], serde_json::json!(DEFAULT_CUT_SIZE));
     let scene = common::mixed_scene(4);
     let s = Slc::new(&scene, c).unwrap();

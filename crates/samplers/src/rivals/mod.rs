@@ -4,5 +4,7 @@
 //! * [`slc`]: stochastic lightcuts (Yuksel, HPG 2019): a cut of at most K nodes refined by
 //!   an error bound, one light per cut node drawn down its subtree, one shadow ray each.
 //! * [`slc_bo`]: `slc-bo+bsdf`, its descent weighed by the paper's BRDF-oriented importance.
+//! * [`slc_minmax`]: the descent of Lin & Yuksel's real-time code, as an option of `slc`.
 pub mod slc;
 pub mod slc_bo;
+pub mod slc_minmax;

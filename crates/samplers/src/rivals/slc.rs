@@ -51,7 +51,8 @@
 //!   normalised weights, intensity × receiver-cosine bound / (nearest box distance)² and the
 //!   same over the farthest box distance, with an intensity-only weight when x is inside
 //!   both boxes. Their weights are not a ratio of per-node importances, so the tree's descent
-//!   cannot run them.
+//!   cannot run them; [`SlcDescent::MinMax`] ([`super::slc_minmax`]) is that descent on our
+//!   cones, for comparison (not our default).
 //!
 //! # MIS with BSDF sampling (`slc+bsdf`)
 //!
@@ -85,6 +86,7 @@
 //! their light samples keep weight 1. [`LightStrategy`] computes exactly these weights,
 //! because a selection's `pmf` is the pick's probability within its part.
 use super::slc_bo::BoWeight;
+pub use super::slc_minmax::SlcDescent;
 use crate::light_strategy::LightStrategy;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
@@ -198,6 +200,8 @@ pub struct SlcSelection {
     floor_sq: f32,
     /// The cap integrals of `slc-bo`'s descent at glossy points (None: the tree's descent).
     bo: Option<Sptd>,
+    /// The descent inside a cut node (where `bo` does not apply).
+    descent: SlcDescent,
 }
 
 impl SlcSelection {
@@ -217,7 +221,14 @@ impl SlcSelection {
             cut_size,
             floor_sq: (floor * floor).max(MIN_DIST_SQ),
             bo: None,
+            descent: SlcDescent::Tree,
         })
+    }
+
+    /// The same selection drawing each cut node's light by `descent`.
+    pub fn with_descent(mut self, descent: SlcDescent) -> Self {
+        self.descent = descent;
+        self
     }
 
     /// The same selection descending by the BRDF-oriented weight at glossy points when `bo`
@@ -319,6 +330,15 @@ impl LightSelection for SlcSelection {
             return;
         }
         let (x, n) = (state.x, state.n);
+        if self.descent == SlcDescent::MinMax {
+            for &node in &cut.nodes {
+                let mut u = Rescaled(rng.next_u64());
+                if let Some((light, pmf)) = super::slc_minmax::sample(tree, node, (x, n), &mut u) {
+                    picks.push((light as u32, pmf));
+                }
+            }
+            return;
+        }
         // One fresh number per cut node, in cut order; two descents side by side.
         let mut pairs = cut.nodes.chunks_exact(2);
         for pair in &mut pairs {
@@ -346,9 +366,11 @@ impl LightSelection for SlcSelection {
         let Some(k) = cut.cluster_of(tree, light) else {
             return 0.0;
         };
-        match &state.bo {
-            Some(bo) => tree.pmf_subtree(cut.nodes[k], |id| bo.weight(tree.node(id)), light),
-            None => tree.pmf_from(cut.nodes[k], state.x, state.n, light),
+        let (node, xn) = (cut.nodes[k], (state.x, state.n));
+        match (&state.bo, self.descent) {
+            (Some(bo), _) => tree.pmf_subtree(node, |id| bo.weight(tree.node(id)), light),
+            (None, SlcDescent::Tree) => tree.pmf_from(node, xn.0, xn.1, light),
+            (None, SlcDescent::MinMax) => super::slc_minmax::pmf(tree, node, xn, light),
         }
     }
 }
@@ -362,6 +384,8 @@ pub struct SlcConfig {
     pub with_bsdf: bool,
     /// At glossy points, descend by the BRDF-oriented weight (`slc-bo+bsdf`, [`super::slc_bo`]).
     pub bo: bool,
+    /// The descent inside a cut node elsewhere (default: the tree's).
+    pub descent: SlcDescent,
     /// The tree's power units (the authors' `LeWithArea` under `--reproduce`, as every tree
     /// strategy).
     pub units: PowerUnits,
@@ -381,6 +405,7 @@ impl SlcConfig {
             cut_size: DEFAULT_CUT_SIZE,
             with_bsdf,
             bo,
+            descent: SlcDescent::Tree,
             units: opts.power_units(),
         })
     }
@@ -402,7 +427,10 @@ pub fn resolved_parameters(config: &SlcConfig) -> serde_json::Value {
         "cut_size": config.cut_size,
         "error_bound": "power x emitter and receiver cone cosines / max(box distance, floor)^2",
         "distance_floor": DISTANCE_FLOOR,
-        "descent": "tree importance (E&K)",
+        "descent": match config.descent {
+            SlcDescent::Tree => "tree importance (E&K)",
+            SlcDescent::MinMax => "mean of nearest- and farthest-box-distance weights (Lin & Yuksel)",
+        },
         "glossy_descent": config.bo.then(|| {
             format!(
                 "I_BO (SPTD, diffuse term) + {} x (ks + kd)/pi x E&K importance",
@@ -426,7 +454,9 @@ impl Slc {
     pub fn new(scene: &Scene, config: SlcConfig) -> Result<Slc, String> {
         Ok(Slc(LightStrategy {
             name: config.name().into(),
-            selection: SlcSelection::new(scene, config.cut_size, config.units)?.with_bo(config.bo),
+            selection: SlcSelection::new(scene, config.cut_size, config.units)?
+                .with_bo(config.bo)
+                .with_descent(config.descent),
             with_bsdf: config.with_bsdf,
             parameters: resolved_parameters(&config),
         }))
