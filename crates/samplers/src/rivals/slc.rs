@@ -35,11 +35,12 @@
 //! to a diffuse receiver: the cosines are bounds over the node, d_box is no longer than the
 //! distance to any of its lights, and radiant intensity ≤ Φ/π in any direction.
 //! Differences from the papers:
-//! * Lightcuts' bound, which the 2019 paper refines by, has a material term, a bound on the
-//!   BSDF over the node's box. We leave it out: the BSDF counts as a constant, i.e. the
+//! * Lightcuts' bound (the 2019 paper builds on lightcuts' cut selection) has a material
+//!   term, a bound on the BSDF over the node's box. We leave it out: the BSDF counts as a constant, i.e. the
 //!   bound is that of a diffuse receiver, and glossy points get the same cut as diffuse ones.
 //!   That is also what Lin & Yuksel's public code does: intensity × receiver-cosine bound ×
-//!   cone bound / clamped box distance².
+//!   cone bound / clamped box distance², its floor a user parameter × the lights' bounding
+//!   radius (ours fixed at ε = 10⁻³).
 //! * Both cosines come from the tree's cones through the node's bounding sphere, not from its
 //!   box as in lightcuts and Lin & Yuksel.
 //! * Lightcuts also stops refining once every node's bound is below 2 % of the estimate; that
@@ -49,8 +50,8 @@
 //!   Φ·cos θ′·cos θ′ᵢ / d², d the distance to the bounding-sphere centre, clamped at r/2. Lin
 //!   & Yuksel's public code (the variant it marks as the paper's) instead averages two
 //!   normalised weights, intensity × receiver-cosine bound / (nearest box distance)² and the
-//!   same over the farthest box distance, with an intensity-only weight when x is inside
-//!   both boxes. Their weights are not a ratio of per-node importances, so the tree's descent
+//!   same over the farthest box distance, the nearest-distance term replaced by the plain
+//!   shares of intensity × cosine bound when x lies in both boxes. Their weights are not a ratio of per-node importances, so the tree's descent
 //!   cannot run them; [`SlcDescent::MinMax`] ([`super::slc_minmax`]) is that descent on our
 //!   cones, for comparison (not our default).
 //!
