@@ -4,6 +4,7 @@
 use crate::StrategyOptions;
 use crate::brdf_oriented::{BoImportance, BrdfIntegral};
 use crate::learned::{LearnTarget, PassWeights};
+use crate::rivals::slc::SlcDescent;
 
 /// What a knob's flag takes.
 #[derive(Clone, Copy, Debug)]
@@ -306,6 +307,27 @@ pub static KNOBS: &[Knob] = &[
         set: |o, s| {
             let names = PassWeights::ALL.map(PassWeights::name);
             o.learned.pass_weights = choice(s, &names, PassWeights::from_name)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "slc-cut-size",
+        help: "Stochastic lightcuts: most nodes in a cut (K), one light and one shadow ray each.",
+        kind: KnobKind::Number,
+        value: |o| o.slc_cut_size.to_string(),
+        set: |o, s| {
+            o.slc_cut_size = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "slc-descent",
+        help: "Stochastic lightcuts: how a cut node's light is drawn down its subtree, `tree` (the tree's importance, ours) or `minmax` (the mean of the nearest- and farthest-distance weights of Lin & Yuksel's real-time code).",
+        kind: KnobKind::Choice(|| SlcDescent::ALL.map(SlcDescent::name).to_vec()),
+        value: |o| o.slc_descent.name().to_string(),
+        set: |o, s| {
+            let names = SlcDescent::ALL.map(SlcDescent::name);
+            o.slc_descent = choice(s, &names, SlcDescent::from_name)?;
             Ok(())
         },
     },

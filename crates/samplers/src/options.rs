@@ -57,6 +57,10 @@ pub struct StrategyOptions {
     pub pilot: bool,
     /// Heuristic 2: P(BO) from BRDF-sampling hits and misses; off: 1/2.
     pub adaptive_split: bool,
+    /// Stochastic lightcuts: most nodes in a cut (K), one shadow ray each (the paper's 32).
+    pub slc_cut_size: usize,
+    /// Stochastic lightcuts: how a cut node's light is drawn down its subtree.
+    pub slc_descent: crate::rivals::slc::SlcDescent,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
     pub learned: learned::LearnedConfig,
 }
@@ -125,6 +129,8 @@ impl Default for StrategyOptions {
             binary_bo_descent: false,
             pilot: true,
             adaptive_split: true,
+            slc_cut_size: crate::rivals::slc::DEFAULT_CUT_SIZE,
+            slc_descent: Default::default(),
             learned: learned::LearnedConfig::default(),
         }
     }

@@ -2,7 +2,7 @@
 //! [`Strategy`] value in its own file and one line here.
 use crate::strategy::Strategy;
 use crate::tree_selection as tree;
-use crate::{StrategyError, brdf_oriented, learned, light_strategy, oracle, ris, sg};
+use crate::{StrategyError, brdf_oriented, learned, light_strategy, oracle, ris, rivals, sg};
 
 /// The registry.
 pub static STRATEGIES: &[&Strategy] = &[
@@ -30,6 +30,9 @@ pub static STRATEGIES: &[&Strategy] = &[
     &ris::strategy::RIS_4,
     &ris::strategy::RIS_32,
     &ris::strategy::RIS_ADAPTIVE,
+    &rivals::slc::SLC,
+    &rivals::slc::SLC_BSDF,
+    &rivals::slc::SLC_BO_BSDF,
 ];
 
 /// The strategy `--strategy name` means: its own name first, then the other names it answers to;

@@ -91,6 +91,7 @@ pub use super::slc_minmax::SlcDescent;
 use crate::light_strategy::LightStrategy;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
+use crate::strategy::Strategy;
 use crate::tree_selection::{PowerUnits, light_bounds};
 use brdf_integrals::Sptd;
 use light_tree::{Cut, LightTree, MIN_DIST_SQ, Node, NodeId, Rescaled};
@@ -393,8 +394,9 @@ pub struct SlcConfig {
 }
 
 impl SlcConfig {
-    /// The configuration of strategy `name` (`slc`, `slc+bsdf`, `slc-bo+bsdf`) under `opts`, with the
-    /// paper's K = [`DEFAULT_CUT_SIZE`] (`opts.max_cut` is the E&K cut's, 64 by default).
+    /// The configuration of strategy `name` (`slc`, `slc+bsdf`, `slc-bo+bsdf`) under `opts`: K is
+    /// `opts.slc_cut_size` (the paper's [`DEFAULT_CUT_SIZE`] by default; `opts.max_cut` is the
+    /// E&K cut's).
     pub fn for_name(name: &str, opts: &crate::StrategyOptions) -> Result<SlcConfig, String> {
         let (with_bsdf, bo) = match name {
             "slc" => (false, false),
@@ -403,10 +405,10 @@ impl SlcConfig {
             other => return Err(format!("not a stochastic-lightcuts strategy: `{other}`")),
         };
         Ok(SlcConfig {
-            cut_size: DEFAULT_CUT_SIZE,
+            cut_size: opts.slc_cut_size,
             with_bsdf,
             bo,
-            descent: SlcDescent::Tree,
+            descent: opts.slc_descent,
             units: opts.power_units(),
         })
     }
@@ -489,3 +491,49 @@ impl DirectLighting for Slc {
         self.0.estimate(scene, sp, rng, ctx)
     }
 }
+
+fn resolve(name: &str, opts: &crate::StrategyOptions) -> serde_json::Value {
+    SlcConfig::for_name(name, opts).map_or(serde_json::Value::Null, |c| resolved_parameters(&c))
+}
+
+fn build(
+    name: &str,
+    scene: &Scene,
+    opts: &crate::StrategyOptions,
+) -> Result<Box<dyn render_core::estimator::DirectLighting>, crate::StrategyError> {
+    let config = SlcConfig::for_name(name, opts).map_err(crate::StrategyError::BadOption)?;
+    Ok(Box::new(
+        Slc::new(scene, config).map_err(crate::StrategyError::BadOption)?,
+    ))
+}
+
+const KNOBS: &[&str] = &["slc-cut-size", "slc-descent"];
+
+/// `slc`.
+pub const SLC: Strategy = Strategy {
+    knobs: KNOBS,
+    ..Strategy::new(
+        "slc",
+        "stochastic lightcuts (Yuksel 2019): an error-bound cut of at most K = 32 tree nodes, one light drawn down each, one shadow ray each",
+        resolve,
+        build,
+    )
+};
+
+/// `slc+bsdf`.
+pub const SLC_BSDF: Strategy = Strategy {
+    knobs: KNOBS,
+    ..Strategy::new("slc+bsdf", "slc + BSDF sampling, MIS", resolve, build)
+};
+
+/// `slc-bo+bsdf`: beyond the paper, the descent in each cut node by the BRDF-oriented importance
+/// at glossy points.
+pub const SLC_BO_BSDF: Strategy = Strategy {
+    knobs: KNOBS,
+    ..Strategy::new(
+        "slc-bo+bsdf",
+        "slc+bsdf with each cut node's descent by the paper's BRDF-oriented importance at glossy points (ours)",
+        resolve,
+        build,
+    )
+};

@@ -17,13 +17,32 @@ use light_tree::{DescentRandom, LightTree, Node, NodeId};
 use render_core::Vec3;
 
 /// How the light of a cut node is drawn down its subtree.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum SlcDescent {
     /// The tree's descent by E&K importance (our default).
     #[default]
     Tree,
     /// The mean of the nearest- and farthest-distance weights (Lin & Yuksel's code).
     MinMax,
+}
+
+impl SlcDescent {
+    /// Every descent, in `--slc-descent`'s order.
+    pub const ALL: [SlcDescent; 2] = [SlcDescent::Tree, SlcDescent::MinMax];
+
+    /// The name `--slc-descent` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            SlcDescent::Tree => "tree",
+            SlcDescent::MinMax => "minmax",
+        }
+    }
+
+    /// The descent called `name`.
+    pub fn from_name(name: &str) -> Option<SlcDescent> {
+        SlcDescent::ALL.into_iter().find(|d| d.name() == name)
+    }
 }
 
 /// Φ · cos θ′ · cos θ′ᵢ of `node` at (x, n): the tree's importance times its clamped squared
