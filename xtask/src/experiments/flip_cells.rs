@@ -2,9 +2,9 @@
 //! their render and reference when both are on this machine (in memory, for the tables; the
 //! cell files stay as they were measured), and each cell's ꟻLIP map (`renders/<id>.flip.png`,
 //! written when the cell is measured) is made there if it is missing.
+use super::cell::CellResult;
 use super::flip;
 use super::reference::Manifest;
-use super::report::CellResult;
 use glam::Vec3;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};

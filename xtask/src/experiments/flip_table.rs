@@ -1,7 +1,8 @@
 //! The ꟻLIP tables of table.md: mean HDR-ꟻLIP per scene × strategy at one budget, mean ± std
 //! over the seeds, the lowest in the row in bold. No speed-ups: ꟻLIP is not proportional to
 //! the variance, so a ratio of ꟻLIP says nothing about time to equal error.
-use super::report::{CellResult, Pixels, Stat};
+use super::cell::CellResult;
+use super::report::{Pixels, Stat};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
@@ -98,7 +99,7 @@ mod tests {
 
     #[test]
     fn an_entry_needs_every_seed() {
-        let mut a = crate::experiments::tests::cell_result("a", "r", "tree:x");
+        let mut a = crate::experiments::cell::testing::cell_result("a", "r", "tree:x");
         let mut b = a.clone();
         a.flip_unlit = Some(0.1);
         a.flip_all = Some(0.2);

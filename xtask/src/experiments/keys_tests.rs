@@ -2,13 +2,16 @@
 //! and references whose inputs changed (a byte of a glTF buffer, of a pbrt include, of a
 //! composition's asset; a strategy's resolved parameters; the threads of a time cell; the
 //! code), and the report refuses a table of mixed code states.
+use super::cell::CellResult;
+use super::cell::read_cell;
+use super::code_state::CodeState;
 use super::config::{Experiment, parse};
+use super::execute::{self, Done, RunOptions};
 use super::manylights::Manylights;
 use super::plan::{self, Budget};
-use super::provenance::{CodeState, Permissions};
-use super::report::CellResult;
-use super::run::{self, Done, RunOptions};
-use super::{read_cell, summary};
+use super::prepare;
+use super::provenance::Permissions;
+use super::summary;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -150,7 +153,7 @@ impl Bench {
             reuse_stale,
             ..RunOptions::default()
         };
-        let p = run::prepare(
+        let p = prepare::prepare(
             &self.exp,
             &self.ml,
             plan::expand(&self.exp),
@@ -158,7 +161,7 @@ impl Bench {
         )
         .unwrap();
         assert_eq!(p.cells.len(), 12, "{:?}", p.notices);
-        let done = run::execute(
+        let done = execute::execute(
             &self.exp,
             &self.ml,
             p,

@@ -1,16 +1,29 @@
 //! `cargo xtask run-experiments` and `cargo xtask merge-results`: scenes × strategies × spp /
 //! time budgets × seeds against cached high-spp references; tables, plots and strips in
 //! `results/<experiment>/`. See docs/experiments.md.
+//!
+//! The modules from the bottom up: `config` (the TOML), `plan` (cells, budgets, keys),
+//! `code_state`, `reference`, `cell` (what a finished cell records), `provenance` (the checks
+//! before a table), `report`/`flip_table` (table formats), `summary` and `viewer` (the report),
+//! then the commands: `run` (`prepare`, `execute`, `measure`), `merge`.
+pub mod cell;
 pub mod charts;
+pub mod code_state;
 pub mod compositing;
 pub mod config;
+pub mod execute;
 pub mod flip;
 pub mod flip_cells;
 pub mod flip_table;
 #[cfg(test)]
 mod keys_tests;
 pub mod manylights;
+pub mod measure;
+pub mod merge;
+pub mod paths;
 pub mod plan;
+pub mod prepare;
+pub mod progress;
 pub mod provenance;
 pub mod reference;
 pub mod report;
@@ -21,139 +34,17 @@ pub mod summary;
 pub mod viewer;
 
 use clap::Parser;
-use config::Experiment;
-use indicatif::MultiProgress;
-use manylights::repo_root;
-use plan::{Cell, Shard, hex_hash};
-use report::CellResult;
-use std::path::{Path, PathBuf};
 use std::process::ExitCode;
-use std::time::Instant;
-
-#[derive(Parser, Debug)]
-#[command(
-    name = "cargo xtask run-experiments",
-    about = "Render an experiment's cells against cached references and write results/<experiment>/"
-)]
-pub struct RunArgs {
-    /// Experiment name (experiments/NAME.toml) or a path to a .toml file.
-    #[arg(long, default_value = "quick")]
-    pub experiment: String,
-    /// List the experiments and exit.
-    #[arg(long)]
-    pub list: bool,
-    /// Only cells whose id, scene, strategy label/name or budget tag matches (substring, `*`
-    /// wildcards; repeatable: any matches).
-    #[arg(long)]
-    pub only: Vec<String>,
-    /// Shard i of n (1-based): a deterministic round-robin split of the cells.
-    #[arg(long)]
-    pub shard: Option<Shard>,
-    /// Render threads (default: the experiment's, else all cores).
-    #[arg(long)]
-    pub threads: Option<usize>,
-    /// Render the references again even when the cached ones are valid.
-    #[arg(long)]
-    pub refresh_references: bool,
-    /// Render finished cells again.
-    #[arg(long)]
-    pub rerender: bool,
-    /// Keep finished cells rendered by other code when nothing else that keys them changed
-    /// (scene, strategy parameters, threads, reference); the table marks their rows.
-    #[arg(long)]
-    pub reuse_stale: bool,
-    /// Write the table even from cells rendered by a dirty build (its header says so).
-    #[arg(long)]
-    pub allow_dirty: bool,
-    /// Write the table even from cells of several code states or references (rows marked).
-    #[arg(long)]
-    pub allow_mixed: bool,
-    /// Render (or check) the references and stop.
-    #[arg(long)]
-    pub references_only: bool,
-    /// Print the cells that would run and exit.
-    #[arg(long)]
-    pub dry_run: bool,
-    /// Results directory (default `results/<experiment>`).
-    #[arg(long)]
-    pub results: Option<PathBuf>,
-}
-
-#[derive(Parser, Debug)]
-#[command(
-    name = "cargo xtask merge-results",
-    about = "Copy finished cells from shard result directories into results/<experiment>/ and regenerate its report"
-)]
-pub struct MergeArgs {
-    #[arg(long, default_value = "quick")]
-    pub experiment: String,
-    /// Result directories of shards (each a copy of some machine's `results/<experiment>/`).
-    pub sources: Vec<PathBuf>,
-    #[arg(long)]
-    pub results: Option<PathBuf>,
-    /// Write the table even from cells rendered by a dirty build (its header says so).
-    #[arg(long)]
-    pub allow_dirty: bool,
-    /// Merge cells of several code states or references (rows marked) and, where two sources
-    /// hold different results for one cell, take the one named last.
-    #[arg(long)]
-    pub allow_mixed: bool,
-}
-
-pub fn experiments_dir() -> PathBuf {
-    repo_root().join("experiments")
-}
-
-pub fn resolve_experiment(name: &str) -> PathBuf {
-    if name.ends_with(".toml") || name.contains('/') {
-        PathBuf::from(name)
-    } else {
-        experiments_dir().join(format!("{name}.toml"))
-    }
-}
-
-fn load_experiment(name: &str) -> Result<Experiment, String> {
-    let path = resolve_experiment(name);
-    if !path.exists() {
-        let mut names: Vec<String> = std::fs::read_dir(experiments_dir())
-            .map(|d| {
-                d.filter_map(|e| {
-                    let p = e.ok()?.path();
-                    (p.extension()? == "toml")
-                        .then(|| p.file_stem().map(|s| s.to_string_lossy().into_owned()))?
-                })
-                .collect()
-            })
-            .unwrap_or_default();
-        names.sort();
-        return Err(format!(
-            "no experiment `{name}` ({} does not exist); experiments: {}",
-            path.display(),
-            names.join(", ")
-        ));
-    }
-    config::load(&path)
-}
-
-fn results_dir(exp: &Experiment, given: &Option<PathBuf>) -> PathBuf {
-    given
-        .clone()
-        .unwrap_or_else(|| repo_root().join("results").join(&exp.name))
-}
-
-pub fn references_dir() -> PathBuf {
-    repo_root().join("references")
-}
 
 /// Entry point of both subcommands; `args` are the words after `cargo xtask`.
 pub fn main(args: &[String]) -> ExitCode {
     let result = match args.first().map(String::as_str) {
-        Some("run-experiments") => match RunArgs::try_parse_from(args) {
+        Some("run-experiments") => match run::RunArgs::try_parse_from(args) {
             Ok(a) => run::run(a),
             Err(e) => e.exit(),
         },
-        Some("merge-results") => match MergeArgs::try_parse_from(args) {
-            Ok(a) => merge(a),
+        Some("merge-results") => match merge::MergeArgs::try_parse_from(args) {
+            Ok(a) => merge::merge(a),
             Err(e) => e.exit(),
         },
         _ => Err("unknown experiments command".into()),
@@ -164,327 +55,5 @@ pub fn main(args: &[String]) -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
-    }
-}
-
-fn list() -> Result<ExitCode, String> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(experiments_dir())
-        .map_err(|e| format!("cannot read experiments/: {e}"))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    files.sort();
-    let now = provenance::clean_code_state(&repo_root());
-    for f in files {
-        match config::load(&f) {
-            Ok(e) => {
-                let cells = repo_root().join("results").join(&e.name).join("cells.json");
-                let fresh =
-                    provenance::Freshness::of(&provenance::cell_code_states(&cells), now.as_ref());
-                println!(
-                    "{:<18} {:>5} cells  {}\n{:<26}{}",
-                    e.name,
-                    plan::expand(&e).len(),
-                    e.description,
-                    "",
-                    fresh.describe(now.is_some())
-                )
-            }
-            Err(err) => println!("{:<18} INVALID: {err}", f.display()),
-        }
-    }
-    Ok(ExitCode::SUCCESS)
-}
-
-/// A notice about something skipped or failed, kept in `results/<exp>/notices.json`.
-#[derive(Clone, Debug, serde::Serialize, serde::Deserialize, PartialEq, Eq, PartialOrd, Ord)]
-pub struct Notice {
-    pub what: String,
-    pub skipped: bool,
-    pub message: String,
-}
-
-fn cell_key(cell: &Cell) -> String {
-    hex_hash(cell.key_material().as_bytes())
-}
-
-fn read_cell(path: &Path) -> Option<CellResult> {
-    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
-}
-
-/// A line above the progress bars, or on stderr when they are hidden (no terminal).
-pub fn say(multi: &MultiProgress, msg: String) -> std::io::Result<()> {
-    if multi.is_hidden() {
-        eprintln!("{msg}");
-        Ok(())
-    } else {
-        multi.println(msg)
-    }
-}
-
-/// Merges the notices with those of earlier runs, writes the report (unless `perm` is `None`:
-/// a `--references-only` run has no new cells to report).
-fn finish(
-    exp: &Experiment,
-    out: &Path,
-    mut notices: Vec<Notice>,
-    start: Instant,
-    failed: bool,
-    perm: Option<&provenance::Permissions>,
-) -> Result<ExitCode, String> {
-    std::fs::create_dir_all(out).map_err(|e| e.to_string())?;
-    notices.sort();
-    notices.dedup();
-    render_core::output::write_json(
-        &out.join("notices.json"),
-        &serde_json::to_value(&notices).unwrap(),
-    )?;
-    if let Some(perm) = perm {
-        summary::generate(exp, out, &references_dir(), &notices, perm)?;
-    }
-    eprintln!(
-        "results in {} ({:.1} s in all)",
-        out.display(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok(if failed {
-        ExitCode::FAILURE
-    } else {
-        ExitCode::SUCCESS
-    })
-}
-
-fn merge(args: MergeArgs) -> Result<ExitCode, String> {
-    let exp = load_experiment(&args.experiment)?;
-    let out = results_dir(&exp, &args.results);
-    let mut notices: Vec<Notice> = std::fs::read_to_string(out.join("notices.json"))
-        .ok()
-        .and_then(|t| serde_json::from_str(&t).ok())
-        .unwrap_or_default();
-    let perm = provenance::Permissions {
-        allow_dirty: args.allow_dirty,
-        allow_mixed: args.allow_mixed,
-        current: None,
-    };
-    let copied = merge_into(&args.sources, &out, &mut notices, &perm)?;
-    eprintln!("merged {copied} cell files into {}", out.display());
-    finish(&exp, &out, notices, Instant::now(), false, Some(&perm))
-}
-
-/// Copies cells (and their renders, when present) from `sources` into `out`. The cells of
-/// `out` and of every source together must be one code state with one reference per scene
-/// (unless `perm.allow_mixed`), and a cell held by two of them with different results is a
-/// conflict (unless `perm.allow_mixed`: then the source named last wins). File times play no
-/// part. Returns how many cell files were copied.
-pub fn merge_into(
-    sources: &[PathBuf],
-    out: &Path,
-    notices: &mut Vec<Notice>,
-    perm: &provenance::Permissions,
-) -> Result<usize, String> {
-    for src in sources {
-        if !src.is_dir() {
-            return Err(format!("{} is not a directory", src.display()));
-        }
-    }
-    // Every cell id → (the directory its chosen result is in, the result); `out` first.
-    let mut chosen: std::collections::BTreeMap<String, (PathBuf, CellResult)> = Default::default();
-    let mut conflicts = Vec::new();
-    for dir in std::iter::once(&out.to_path_buf()).chain(sources) {
-        let Ok(entries) = std::fs::read_dir(dir.join("cells")) else {
-            continue;
-        };
-        let mut files: Vec<PathBuf> = entries.flatten().map(|e| e.path()).collect();
-        files.sort();
-        for f in files
-            .iter()
-            .filter(|f| f.extension().is_some_and(|x| x == "json"))
-        {
-            let c = read_cell(f).ok_or_else(|| format!("{} is not a cell file", f.display()))?;
-            if let Some((d, old)) = chosen.get(&c.id)
-                && old != &c
-                && d != out
-            {
-                conflicts.push(format!(
-                    "{} differs between {} and {}",
-                    c.id,
-                    d.display(),
-                    dir.display()
-                ));
-            }
-            chosen.insert(c.id.clone(), (dir.clone(), c));
-        }
-    }
-    if !conflicts.is_empty() && !perm.allow_mixed {
-        return Err(format!(
-            "refusing to merge: {} (pass --allow-mixed to take the source named last)",
-            conflicts.join("; ")
-        ));
-    }
-    let cells: Vec<CellResult> = chosen.values().map(|(_, c)| c.clone()).collect();
-    provenance::Provenance::check(&cells, perm)?;
-    for sub in ["cells", "renders"] {
-        std::fs::create_dir_all(out.join(sub)).map_err(|e| e.to_string())?;
-    }
-    let mut copied = 0;
-    for (id, (dir, _)) in &chosen {
-        if dir.canonicalize().ok() == out.canonicalize().ok() {
-            continue;
-        }
-        let file = format!("{id}.json");
-        copy_atomically(
-            &dir.join("cells").join(&file),
-            &out.join("cells").join(&file),
-        )?;
-        copied += 1;
-        // The render and its siblings (<id>.exr, <id>.json, <id>.mask.png, …).
-        let Ok(entries) = std::fs::read_dir(dir.join("renders")) else {
-            continue;
-        };
-        let prefix = format!("{id}.");
-        for e in entries.flatten() {
-            if e.file_name().to_string_lossy().starts_with(&prefix) {
-                copy_atomically(&e.path(), &out.join("renders").join(e.file_name()))?;
-            }
-        }
-    }
-    for src in sources {
-        if let Some(n) = std::fs::read_to_string(src.join("notices.json"))
-            .ok()
-            .and_then(|t| serde_json::from_str::<Vec<Notice>>(&t).ok())
-        {
-            notices.extend(n);
-        }
-    }
-    Ok(copied)
-}
-
-fn copy_atomically(from: &Path, to: &Path) -> Result<(), String> {
-    render_core::output::write_atomically(to, |tmp| {
-        std::fs::copy(from, tmp)
-            .map(|_| ())
-            .map_err(|e| format!("cannot copy {}: {e}", from.display()))
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use plan::Budget;
-    use provenance::{CodeState, Permissions};
-
-    pub fn code(id: &str, dirty: bool) -> CodeState {
-        CodeState {
-            id: id.into(),
-            commit: Some("0123456789ab".into()),
-            dirty,
-        }
-    }
-
-    pub fn cell_result(id: &str, reference: &str, code_id: &str) -> CellResult {
-        CellResult {
-            id: id.into(),
-            key: "k".into(),
-            experiment: "t".into(),
-            scene: "s".into(),
-            scene_spec: "builtin:s".into(),
-            strategy: "a".into(),
-            strategy_name: "tree".into(),
-            strategy_args: vec![],
-            budget: Budget::Spp(4),
-            seed: 0,
-            width: 2,
-            height: 2,
-            reference: reference.into(),
-            reference_dir: "r".into(),
-            reference_noise_unlit: 0.0,
-            all: Default::default(),
-            unlit: Default::default(),
-            spp: 4,
-            wall_seconds: 1.0,
-            cpu_seconds: 2.0,
-            render: serde_json::json!({}),
-            code: Some(code(code_id, false)),
-            inputs: None,
-            flip_all: None,
-            flip_unlit: None,
-        }
-    }
-
-    fn cell_file(dir: &Path, c: &CellResult) -> PathBuf {
-        std::fs::create_dir_all(dir).unwrap();
-        let p = dir.join(format!("{}.json", c.id));
-        render_core::output::write_json(&p, &serde_json::to_value(c).unwrap()).unwrap();
-        p
-    }
-
-    #[test]
-    fn merge_copies_cells_and_renders_from_shards() {
-        let base = std::env::temp_dir().join(format!("xtask-merge-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&base);
-        cell_file(&base.join("s1/cells"), &cell_result("c1", "r", "tree:a"));
-        cell_file(&base.join("s2/cells"), &cell_result("c2", "r", "tree:a"));
-        std::fs::create_dir_all(base.join("s2/renders")).unwrap();
-        std::fs::write(base.join("s2/renders/c2.exr"), "x").unwrap();
-        std::fs::write(base.join("s2/renders/c22.exr"), "not c2's").unwrap();
-        let mut notices = vec![];
-        let out = base.join("out");
-        let perm = Permissions::default();
-        let n = merge_into(
-            &[base.join("s1"), base.join("s2")],
-            &out,
-            &mut notices,
-            &perm,
-        );
-        assert_eq!(n, Ok(2));
-        assert!(out.join("cells/c1.json").is_file() && out.join("cells/c2.json").is_file());
-        assert!(out.join("renders/c2.exr").is_file());
-        assert!(
-            !out.join("renders/c22.exr").is_file(),
-            "another cell's render"
-        );
-        let _ = std::fs::remove_dir_all(&base);
-    }
-
-    #[test]
-    fn merge_refuses_mixed_code_states_references_and_conflicts() {
-        let base = std::env::temp_dir().join(format!("xtask-merge-mix-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&base);
-        let out = base.join("out");
-        let perm = Permissions::default();
-        let mixed = Permissions {
-            allow_mixed: true,
-            ..Permissions::default()
-        };
-        let mut notices = vec![];
-        // two shards of two code states
-        cell_file(&base.join("a/cells"), &cell_result("c1", "r", "tree:a"));
-        cell_file(&base.join("b/cells"), &cell_result("c2", "r", "tree:b"));
-        let both = [base.join("a"), base.join("b")];
-        let e = merge_into(&both, &out, &mut notices, &perm).unwrap_err();
-        assert!(e.contains("several code states"), "{e}");
-        assert!(!out.join("cells/c1.json").exists(), "nothing merged");
-        // two references of one scene
-        cell_file(&base.join("b/cells"), &cell_result("c2", "r2", "tree:a"));
-        let e = merge_into(&both, &out, &mut notices, &perm).unwrap_err();
-        assert!(e.contains("2 references"), "{e}");
-        // one cell with different results in two shards, whatever their file times
-        cell_file(&base.join("b/cells"), &cell_result("c1", "r", "tree:a"));
-        let mut other = cell_result("c1", "r", "tree:a");
-        other.spp = 5;
-        cell_file(&base.join("b/cells"), &other);
-        std::fs::remove_file(base.join("b/cells/c2.json")).unwrap();
-        let e = merge_into(&both, &out, &mut notices, &perm).unwrap_err();
-        assert!(e.contains("c1 differs"), "{e}");
-        // told: the one named last wins
-        assert_eq!(merge_into(&both, &out, &mut notices, &mixed), Ok(1));
-        assert_eq!(read_cell(&out.join("cells/c1.json")).unwrap().spp, 5);
-        // a dirty cell is refused unless allowed
-        let mut dirty = cell_result("c3", "r", "binary:1");
-        dirty.code = Some(code("binary:1", true));
-        cell_file(&base.join("d/cells"), &dirty);
-        let e = merge_into(&[base.join("d")], &base.join("out2"), &mut notices, &perm).unwrap_err();
-        assert!(e.contains("--allow-dirty"), "{e}");
-        let _ = std::fs::remove_dir_all(&base);
     }
 }

@@ -58,6 +58,13 @@ impl Budget {
     }
 }
 
+/// The experiment's budgets: its spp counts, then its time budgets.
+pub fn budgets(exp: &Experiment) -> Vec<Budget> {
+    let mut b: Vec<Budget> = exp.spp.iter().map(|&n| Budget::Spp(n)).collect();
+    b.extend(exp.time_budgets.iter().map(|&t| Budget::Time(t)));
+    b
+}
+
 /// One render to make and measure.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Cell {
@@ -147,8 +154,7 @@ pub fn scene_resolution(exp: &Experiment, scene: &SceneEntry) -> (u32, u32) {
 
 /// Every cell in a fixed order: scene, budget (spp ascending, then time), strategy, seed.
 pub fn expand(exp: &Experiment) -> Vec<Cell> {
-    let mut budgets: Vec<Budget> = exp.spp.iter().map(|&n| Budget::Spp(n)).collect();
-    budgets.extend(exp.time_budgets.iter().map(|&t| Budget::Time(t)));
+    let budgets = budgets(exp);
     let mut cells = Vec::new();
     for scene in &exp.scenes {
         let (width, height) = scene_resolution(exp, scene);

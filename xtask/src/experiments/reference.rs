@@ -4,7 +4,7 @@
 //! last, so a directory without a manifest is an interrupted render.
 use super::manylights::{Failure, Manylights};
 use super::plan::{hex_hash, slug};
-use super::say;
+use super::progress::say;
 use glam::Vec3;
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use render_core::metrics::error_metrics;

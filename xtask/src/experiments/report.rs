@@ -1,67 +1,10 @@
-//! Cell results and what is made of them: cells.csv, cells.json, table.md, plots, strips.
+//! The statistics and formats of the tables: entries over seeds, speed-ups, the paper-style
+//! markdown tables, cells.csv.
+use super::cell::CellResult;
 use super::config::BudgetClock;
 use super::plan::Budget;
-use super::provenance::{CellInputs, CodeState};
-use super::reference::Metric;
-use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write;
-
-/// `results/<experiment>/cells/<id>.json`: one finished cell.
-#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct CellResult {
-    pub id: String,
-    /// Hash of everything that determines the result; a stored cell with another key is stale.
-    pub key: String,
-    pub experiment: String,
-    pub scene: String,
-    pub scene_spec: String,
-    pub strategy: String,
-    pub strategy_name: String,
-    pub strategy_args: Vec<String>,
-    pub budget: Budget,
-    pub seed: u64,
-    pub width: u32,
-    pub height: u32,
-    /// Content id of the reference the cell was measured against.
-    pub reference: String,
-    /// Its directory under references/.
-    pub reference_dir: String,
-    pub reference_noise_unlit: f64,
-    pub all: Metric,
-    pub unlit: Metric,
-    /// Mean HDR-ꟻLIP over all pixels and over the unlit ones (see [`super::flip`]); absent in
-    /// cells from before it was measured (the report computes it when the render is there).
-    #[serde(default)]
-    pub flip_all: Option<f64>,
-    #[serde(default)]
-    pub flip_unlit: Option<f64>,
-    pub spp: u64,
-    pub wall_seconds: f64,
-    pub cpu_seconds: f64,
-    /// The render's own JSON (stats, rays, technique samples, parameters, commit).
-    pub render: serde_json::Value,
-    /// The code that rendered it (absent in cells from before it was recorded).
-    #[serde(default)]
-    pub code: Option<CodeState>,
-    /// The loaded scene, the strategy's resolved parameters and (time budgets) the threads.
-    #[serde(default)]
-    pub inputs: Option<CellInputs>,
-}
-
-impl CellResult {
-    /// The render's duration on `clock`: wall seconds, or CPU seconds per worker thread (wall
-    /// seconds where the render did not record its CPU time or thread count).
-    pub fn seconds(&self, clock: BudgetClock) -> f64 {
-        let threads = self.render["worker_threads"].as_u64().unwrap_or(0);
-        match clock {
-            BudgetClock::Cpu if threads > 0 && self.cpu_seconds > 0.0 => {
-                self.cpu_seconds / threads as f64
-            }
-            _ => self.wall_seconds,
-        }
-    }
-}
 
 /// Mean and sample standard deviation.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -352,7 +295,7 @@ pub fn write_csv(path: &std::path::Path, cells: &[CellResult]) -> Result<(), Str
         let mut w = csv::Writer::from_path(tmp).map_err(|e| e.to_string())?;
         w.write_record(CSV_HEADER).map_err(|e| e.to_string())?;
         for c in cells {
-            let code = super::provenance::code_of(c);
+            let code = c.code_state();
             let (kind, value) = match c.budget {
                 Budget::Spp(n) => ("spp", n.to_string()),
                 Budget::Time(t) => ("time", t.to_string()),
@@ -477,11 +420,11 @@ mod tests {
 
     #[test]
     fn csv_round_trips_flip_and_leaves_it_empty_for_old_cells() {
-        let mut a = crate::experiments::tests::cell_result("a", "r", "tree:x");
+        let mut a = crate::experiments::cell::testing::cell_result("a", "r", "tree:x");
         a.flip_unlit = Some(0.123_456_789_012_345_6);
         a.flip_all = Some(1.0 / 3.0);
         a.unlit.rel_mse = 2.5e-3;
-        let b = crate::experiments::tests::cell_result("b", "r", "tree:x");
+        let b = crate::experiments::cell::testing::cell_result("b", "r", "tree:x");
         let path = std::env::temp_dir().join(format!("xtask-csv-{}.csv", std::process::id()));
         write_csv(&path, &[a.clone(), b]).unwrap();
         let mut r = csv::Reader::from_path(&path).unwrap();

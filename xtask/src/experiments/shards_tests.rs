@@ -3,13 +3,16 @@
 //! `merge-results` equals the same experiment run at once: the same cells with the same keys,
 //! references, metrics (relMSE and ꟻLIP) and images, and the same cells.csv but for the
 //! timings. Also: cells of before ꟻLIP get it from their render, or an empty column without one.
+use super::cell::CellResult;
+use super::cell::read_cell;
 use super::config::{Experiment, parse};
+use super::execute::{self, RunOptions};
 use super::manylights::Manylights;
+use super::merge::merge_into;
 use super::plan::{self, Shard};
+use super::prepare;
 use super::provenance::Permissions;
-use super::report::CellResult;
-use super::run::{self, RunOptions};
-use super::{merge_into, read_cell, summary};
+use super::summary;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -52,9 +55,9 @@ fn run_into(exp: &Experiment, ml: &Manylights, shard: Option<Shard>, out: &Path,
         threads: Some(1),
         ..RunOptions::default()
     };
-    let p = run::prepare(exp, ml, cells, options.threads).unwrap();
+    let p = prepare::prepare(exp, ml, cells, options.threads).unwrap();
     assert!(p.notices.is_empty(), "{:?}", p.notices);
-    let done = run::execute(exp, ml, p, out, refs, &options, Instant::now()).unwrap();
+    let done = execute::execute(exp, ml, p, out, refs, &options, Instant::now()).unwrap();
     assert!(!done.failed, "{:?}", done.notices);
 }
 

@@ -9,10 +9,10 @@
 pub mod encode;
 pub mod markdown;
 
+use super::cell::CellResult;
 use super::config::Experiment;
 use super::flip_cells;
 use super::plan::{Budget, slug};
-use super::report::CellResult;
 use glam::Vec3;
 use serde_json::{Value, json};
 use std::fmt::Write;
@@ -130,7 +130,7 @@ fn scene_data(
     let previous = previous_cells(&out.join("viewer").join(format!("{}.js", slug(scene))));
     let mut budgets = Vec::new();
     let mut items = Vec::new();
-    for budget in super::summary::budgets(exp) {
+    for budget in super::plan::budgets(exp) {
         let label = budget_label(&budget);
         for col in cols {
             let Some(c) = mine

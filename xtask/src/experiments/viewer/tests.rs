@@ -1,11 +1,12 @@
 //! The report page from a small synthetic experiment: well formed, self-contained, every file
 //! it names present, every image decoding to its render.
 use super::encode;
+use crate::experiments::cell::CellResult;
+use crate::experiments::cell::cell_key;
 use crate::experiments::config::parse;
 use crate::experiments::plan::{self, Budget};
 use crate::experiments::reference::Metric;
-use crate::experiments::report::CellResult;
-use crate::experiments::{cell_key, summary};
+use crate::experiments::summary;
 use glam::Vec3;
 use std::path::Path;
 
@@ -371,7 +372,7 @@ fn images_of_the_committed_viewer_are_kept_only_for_the_same_cell() {
     let dir = std::env::temp_dir().join(format!("xtask-viewer-keep-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
-    let mut c = crate::experiments::tests::cell_result("s__A__spp4__seed0", "r", "c");
+    let mut c = crate::experiments::cell::testing::cell_result("s__A__spp4__seed0", "r", "c");
     c.unlit.rel_mse = 1.2345678901234567e-2;
     let js = dir.join("s.js");
     let entry = serde_json::json!({"cells": [{"id": c.id, "spp": c.spp, "rel_mse": c.unlit.rel_mse,
