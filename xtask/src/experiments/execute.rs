@@ -5,6 +5,7 @@ use super::code_state::CodeState;
 use super::config::Experiment;
 use super::manylights::{Failure, Manylights};
 use super::measure::{check_render, measure};
+use super::paths;
 use super::plan::{self, Budget, Cell};
 use super::prepare::{Prepared, failure_notice};
 use super::progress::say;
@@ -116,6 +117,7 @@ fn ensure_references(
             threads: Some(p.threads),
             force: options.refresh_references,
         };
+        paths::seed_reference(refs_dir, &ensure.identity.dir_name())?;
         match ensure.run(multi) {
             Ok(r) => {
                 references.insert(label, r);

@@ -4,6 +4,7 @@
 //! written when the cell is measured) is made there if it is missing.
 use super::cell::CellResult;
 use super::flip;
+use super::paths::reference_path;
 use super::reference::Manifest;
 use glam::Vec3;
 use std::collections::BTreeMap;
@@ -35,7 +36,7 @@ impl<'a> Sources<'a> {
 
     /// The reference `cell` was measured against, if it is on this machine and still that one.
     fn reference(&mut self, cell: &CellResult) -> Option<&RefImage> {
-        let dir = self.refs_dir.join(&cell.reference_dir);
+        let dir = reference_path(self.refs_dir, &cell.reference_dir);
         self.refs
             .entry(cell.reference.clone())
             .or_insert_with(|| {

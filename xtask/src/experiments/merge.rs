@@ -2,7 +2,7 @@
 //! results directory, checked (one code state, one reference per scene, no conflicts), and its
 //! report regenerated.
 use super::cell::{CellResult, Notice, read_cell};
-use super::paths::{load_experiment, results_dir};
+use super::paths::{OutputArgs, load_experiment};
 use super::provenance;
 use super::summary::finish;
 use clap::Parser;
@@ -13,15 +13,15 @@ use std::time::Instant;
 #[derive(Parser, Debug)]
 #[command(
     name = "cargo xtask merge-results",
-    about = "Copy finished cells from shard result directories into results/<experiment>/ and regenerate its report"
+    about = "Copy finished cells from shard result directories into out/<experiment>/ (results/<experiment>/ with --publish) and regenerate its report"
 )]
 pub struct MergeArgs {
     #[arg(long, default_value = "quick")]
     pub experiment: String,
-    /// Result directories of shards (each a copy of some machine's `results/<experiment>/`).
+    /// Result directories of shards (each a copy of some machine's `out/<experiment>/`).
     pub sources: Vec<PathBuf>,
-    #[arg(long)]
-    pub results: Option<PathBuf>,
+    #[command(flatten)]
+    pub output: OutputArgs,
     /// Write the table even from cells rendered by a dirty build (its header says so).
     #[arg(long)]
     pub allow_dirty: bool,
@@ -33,7 +33,7 @@ pub struct MergeArgs {
 
 pub fn merge(args: MergeArgs) -> Result<ExitCode, String> {
     let exp = load_experiment(&args.experiment)?;
-    let out = results_dir(&exp, &args.results);
+    let out = args.output.dir(&exp);
     let mut notices: Vec<Notice> = std::fs::read_to_string(out.join("notices.json"))
         .ok()
         .and_then(|t| serde_json::from_str(&t).ok())
@@ -45,7 +45,62 @@ pub fn merge(args: MergeArgs) -> Result<ExitCode, String> {
     };
     let copied = merge_into(&args.sources, &out, &mut notices, &perm)?;
     eprintln!("merged {copied} cell files into {}", out.display());
-    finish(&exp, &out, notices, Instant::now(), false, Some(&perm))
+    finish(
+        &exp,
+        &out,
+        &args.output.references(),
+        notices,
+        Instant::now(),
+        false,
+        Some(&perm),
+    )
+}
+
+#[derive(Parser, Debug)]
+#[command(
+    name = "cargo xtask report",
+    about = "Rebuild an experiment's report (table.md, cells.csv, plots, strips, index.html and its viewer) from the cell files of a local run in out/<experiment>/ (results/<experiment>/ with --publish)"
+)]
+pub struct ReportArgs {
+    #[arg(long, default_value = "quick")]
+    pub experiment: String,
+    #[command(flatten)]
+    pub output: OutputArgs,
+    /// Write the table even from cells rendered by a dirty build (its header says so).
+    #[arg(long)]
+    pub allow_dirty: bool,
+    /// Write the table even from cells of several code states or references (rows marked).
+    #[arg(long)]
+    pub allow_mixed: bool,
+}
+
+/// `cargo xtask report`: `merge-results` without sources, refused where there are no cell
+/// files (the published results keep only tables and plots: their report needs a run).
+pub fn report(args: ReportArgs) -> Result<ExitCode, String> {
+    let exp = load_experiment(&args.experiment)?;
+    let dir = args.output.dir(&exp);
+    let has_cells = std::fs::read_dir(dir.join("cells"))
+        .map(|d| {
+            d.flatten()
+                .any(|e| e.path().extension().is_some_and(|x| x == "json"))
+        })
+        .unwrap_or(false);
+    if !has_cells {
+        return Err(format!(
+            "no cell files in {}: run `cargo xtask run-experiments --experiment {}` first \
+             (the committed results/{}/ holds the tables and plots, not the cells)",
+            dir.join("cells").display(),
+            exp.name,
+            exp.name
+        ));
+    }
+    merge(MergeArgs {
+        experiment: args.experiment,
+        sources: vec![],
+        output: args.output,
+        allow_dirty: args.allow_dirty,
+        allow_mixed: args.allow_mixed,
+    })
 }
 
 /// Copies cells (and their renders, when present) from `sources` into `out`. The cells of

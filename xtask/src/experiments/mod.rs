@@ -1,6 +1,7 @@
-//! `cargo xtask run-experiments` and `cargo xtask merge-results`: scenes × strategies × spp /
+//! `cargo xtask run-experiments`, `merge-results` and `report`: scenes × strategies × spp /
 //! time budgets × seeds against cached high-spp references; tables, plots and strips in
-//! `results/<experiment>/`. See docs/experiments.md.
+//! `out/<experiment>/`, or the published `results/<experiment>/` (`--publish`). See
+//! docs/experiments.md.
 //!
 //! The modules from the bottom up: `config` (the TOML), `plan` (cells, budgets, keys),
 //! `code_state`, `reference`, `cell` (what a finished cell records), `provenance` (the checks
@@ -36,7 +37,7 @@ pub mod viewer;
 use clap::Parser;
 use std::process::ExitCode;
 
-/// Entry point of both subcommands; `args` are the words after `cargo xtask`.
+/// Entry point of `run-experiments`, `merge-results` and `report`; `args` are the words after `cargo xtask`.
 pub fn main(args: &[String]) -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("run-experiments") => match run::RunArgs::try_parse_from(args) {
@@ -45,6 +46,10 @@ pub fn main(args: &[String]) -> ExitCode {
         },
         Some("merge-results") => match merge::MergeArgs::try_parse_from(args) {
             Ok(a) => merge::merge(a),
+            Err(e) => e.exit(),
+        },
+        Some("report") => match merge::ReportArgs::try_parse_from(args) {
+            Ok(a) => merge::report(a),
             Err(e) => e.exit(),
         },
         _ => Err("unknown experiments command".into()),

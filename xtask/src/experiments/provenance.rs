@@ -65,19 +65,28 @@ impl Freshness {
     }
 }
 
-/// The code states of the cells in `results/NAME/cells.json` (empty if there is none).
-pub fn cell_code_states(cells_json: &Path) -> Vec<CodeState> {
-    let Ok(text) = std::fs::read_to_string(cells_json) else {
+/// The code states of the cells in a `cells.csv` (empty if there is none): its columns
+/// `code_state`, `code_commit`, `code_dirty`.
+pub fn cell_code_states(cells_csv: &Path) -> Vec<CodeState> {
+    let Ok(mut reader) = csv::Reader::from_path(cells_csv) else {
         return Vec::new();
     };
-    let Ok(cells) = serde_json::from_str::<Vec<serde_json::Value>>(&text) else {
+    let Ok(header) = reader.headers().cloned() else {
         return Vec::new();
     };
-    cells
-        .iter()
-        .map(|c| {
-            serde_json::from_value::<CodeState>(c["code"].clone())
-                .unwrap_or_else(|_| CodeState::legacy(&c["render"]))
+    let col = |name: &str| header.iter().position(|h| h == name);
+    let (Some(id), Some(commit), Some(dirty)) =
+        (col("code_state"), col("code_commit"), col("code_dirty"))
+    else {
+        return Vec::new();
+    };
+    reader
+        .records()
+        .flatten()
+        .map(|r| CodeState {
+            id: r[id].to_string(),
+            commit: (!r[commit].is_empty()).then(|| r[commit].to_string()),
+            dirty: &r[dirty] == "true",
         })
         .collect()
 }
@@ -236,5 +245,21 @@ mod tests {
             Freshness::of(&dirty, Some(&now)),
             Freshness::Mixed { states: 1 }
         );
+    }
+
+    /// `--list` reads the code states from the published cells.csv.
+    #[test]
+    fn code_states_from_cells_csv() {
+        use crate::experiments::cell::testing::{cell_result, code};
+        let path = std::env::temp_dir().join(format!("xtask-states-{}.csv", std::process::id()));
+        let mut dirty = cell_result("b", "r", "binary:1");
+        dirty.code = Some(code("binary:1", true));
+        let cells = [cell_result("a", "r", "tree:x"), dirty];
+        crate::experiments::report::write_csv(&path, &cells).unwrap();
+        let states = cell_code_states(&path);
+        let expected: Vec<CodeState> = cells.iter().map(|c| c.code_state()).collect();
+        assert_eq!(states, expected);
+        assert!(cell_code_states(&path.with_extension("absent")).is_empty());
+        let _ = std::fs::remove_file(&path);
     }
 }

@@ -7,7 +7,7 @@ use super::code_state;
 use super::config::{self, Experiment};
 use super::execute::{RunOptions, execute};
 use super::manylights::{Manylights, repo_root};
-use super::paths::{experiments_dir, load_experiment, references_dir, results_dir};
+use super::paths::{OutputArgs, experiments_dir, load_experiment, published_dir};
 use super::plan::{self, Cell, Shard};
 use super::prepare::prepare;
 use super::provenance::{self, Permissions};
@@ -20,7 +20,7 @@ use std::time::Instant;
 #[derive(Parser, Debug)]
 #[command(
     name = "cargo xtask run-experiments",
-    about = "Render an experiment's cells against cached references and write results/<experiment>/"
+    about = "Render an experiment's cells against cached references and write out/<experiment>/ (results/<experiment>/ with --publish)"
 )]
 pub struct RunArgs {
     /// Experiment name (experiments/NAME.toml) or a path to a .toml file.
@@ -61,9 +61,8 @@ pub struct RunArgs {
     /// Print the cells that would run and exit.
     #[arg(long)]
     pub dry_run: bool,
-    /// Results directory (default `results/<experiment>`).
-    #[arg(long)]
-    pub results: Option<PathBuf>,
+    #[command(flatten)]
+    pub output: OutputArgs,
 }
 
 pub fn run(args: RunArgs) -> Result<ExitCode, String> {
@@ -71,7 +70,8 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         return list();
     }
     let exp = load_experiment(&args.experiment)?;
-    let out = results_dir(&exp, &args.results);
+    let out = args.output.dir(&exp);
+    let refs = args.output.references();
     let cells = select_cells(&exp, &args);
     if args.dry_run {
         print_plan(&cells);
@@ -92,15 +92,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         allow_mixed: args.allow_mixed || args.reuse_stale,
         current: Some(prepared.code.clone()),
     };
-    let done = execute(
-        &exp,
-        &ml,
-        prepared,
-        &out,
-        &references_dir(),
-        &options,
-        start,
-    )?;
+    let done = execute(&exp, &ml, prepared, &out, &refs, &options, start)?;
     if !done.references_rendered.is_empty() {
         eprintln!(
             "references rendered: {}",
@@ -108,7 +100,7 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         );
     }
     let report = (!options.references_only).then_some(&perm);
-    finish(&exp, &out, done.notices, start, done.failed, report)
+    finish(&exp, &out, &refs, done.notices, start, done.failed, report)
 }
 
 /// `--list`: every experiment, its cell count and how its results stand against today's code.
@@ -123,7 +115,7 @@ fn list() -> Result<ExitCode, String> {
     for f in files {
         match config::load(&f) {
             Ok(e) => {
-                let cells = repo_root().join("results").join(&e.name).join("cells.json");
+                let cells = published_dir(&e).join("cells.csv");
                 let fresh =
                     provenance::Freshness::of(&provenance::cell_code_states(&cells), now.as_ref());
                 println!(

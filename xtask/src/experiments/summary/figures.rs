@@ -6,6 +6,7 @@ use crate::experiments::charts::{self, Series};
 use crate::experiments::compositing::{self, StripColumn};
 use crate::experiments::config::Experiment;
 use crate::experiments::flip;
+use crate::experiments::paths::reference_path;
 use crate::experiments::plan::{Budget, slug};
 use crate::experiments::report::{self, Pixels};
 use std::fmt::Write;
@@ -136,7 +137,7 @@ fn strip(
     let Some(first) = mine.first() else {
         return Ok(None);
     };
-    let ref_dir = refs_dir.join(&first.reference_dir);
+    let ref_dir = reference_path(refs_dir, &first.reference_dir);
     if !ref_dir.join("ref.exr").is_file() {
         return Ok(None);
     }

@@ -8,7 +8,6 @@ mod tables;
 use crate::experiments::cell::{CellResult, Notice, cell_key, read_cell};
 use crate::experiments::config::Experiment;
 use crate::experiments::flip_cells;
-use crate::experiments::paths::references_dir;
 use crate::experiments::plan;
 use crate::experiments::provenance::{Permissions, Provenance};
 use crate::experiments::report::{self, Pixels};
@@ -80,6 +79,7 @@ pub fn generate(
 pub fn finish(
     exp: &Experiment,
     out: &Path,
+    refs_dir: &Path,
     mut notices: Vec<Notice>,
     start: Instant,
     failed: bool,
@@ -93,7 +93,7 @@ pub fn finish(
         &serde_json::to_value(&notices).unwrap(),
     )?;
     if let Some(perm) = perm {
-        generate(exp, out, &references_dir(), &notices, perm)?;
+        generate(exp, out, refs_dir, &notices, perm)?;
     }
     eprintln!(
         "results in {} ({:.1} s in all)",

@@ -13,6 +13,7 @@ use super::cell::CellResult;
 use super::config::Experiment;
 use super::flip_cells;
 use super::plan::{Budget, slug};
+use crate::experiments::paths::reference_path;
 use glam::Vec3;
 use serde_json::{Value, json};
 use std::fmt::Write;
@@ -111,7 +112,7 @@ fn scene_data(
     let mut reference = Value::Null;
     let mut exposure = 1.0f32;
     if let Some(first) = mine.first() {
-        let dir = refs_dir.join(&first.reference_dir);
+        let dir = reference_path(refs_dir, &first.reference_dir);
         if let Ok((rw, rh, px)) = render_core::output::read_exr(&dir.join("ref.exr"))
             && (rw, rh) == (w, h)
         {
