@@ -8,7 +8,7 @@ use super::measure::{check_render, measure};
 use super::paths;
 use super::plan::{self, Budget, Cell};
 use super::prepare::{Prepared, failure_notice};
-use super::progress::say;
+use super::progress::{Eta, say};
 use super::reference::{self, Ensure, Identity, Reference, Validity};
 use indicatif::{MultiProgress, ProgressBar, ProgressStyle};
 use std::collections::{BTreeMap, BTreeSet};
@@ -224,30 +224,45 @@ impl CellRenderer<'_> {
             std::fs::create_dir_all(d)
                 .map_err(|e| format!("cannot create {}: {e}", d.display()))?;
         }
-        let cells = &self.prepared.cells;
-        let total = multi.add(ProgressBar::new(cells.len() as u64));
+        // The cells kept from an earlier run first, so that the estimate counts only renders.
+        let (kept, to_render): (Vec<&Cell>, Vec<&Cell>) = self
+            .prepared
+            .cells
+            .iter()
+            .partition(|c| self.is_finished(c, &references[&c.scene_label]));
+        done.reused.extend(kept.iter().map(|c| c.id()));
+        say(
+            multi,
+            format!(
+                "{} cells to render, {} kept from an earlier run",
+                to_render.len(),
+                kept.len()
+            ),
+        )
+        .ok();
+        let total = multi.add(ProgressBar::new(to_render.len() as u64));
         total.set_style(style(
             "cells {pos}/{len} {wide_bar} [{elapsed_precise}, eta {eta}]",
         ));
+        let mut eta = Eta::new(to_render.len());
         let mut skipped_strategies: BTreeSet<String> = BTreeSet::new();
-        for cell in cells {
+        for cell in to_render {
             let reference = &references[&cell.scene_label];
-            if self.is_finished(cell, reference) {
-                done.reused.push(cell.id());
-                total.inc(1);
-                continue;
-            }
             if skipped_strategies.contains(&cell.strategy.label) {
+                eta.pass();
                 total.inc(1);
                 continue;
             }
-            match self.render_one(cell, reference, multi, &total, &mut done.notices)? {
+            let (outcome, line) =
+                self.render_one(cell, reference, multi, &total, &mut done.notices)?;
+            match outcome {
                 Outcome::Rendered => done.rendered.push(cell.id()),
                 Outcome::Skipped => {
                     skipped_strategies.insert(cell.strategy.label.clone());
                 }
                 Outcome::Failed => done.failed = true,
             }
+            say(multi, eta.line(&line)).ok();
             total.inc(1);
         }
         total.finish_and_clear();
@@ -284,7 +299,7 @@ impl CellRenderer<'_> {
         multi: &MultiProgress,
         total: &ProgressBar,
         notices: &mut Vec<Notice>,
-    ) -> Result<Outcome, String> {
+    ) -> Result<(Outcome, String), String> {
         let id = cell.id();
         let path = self.cells_dir.join(format!("{id}.json"));
         let cmd = render_args(cell, Some(self.prepared.threads))?;
@@ -313,13 +328,14 @@ impl CellRenderer<'_> {
                 };
                 let n = failure_notice(what, f);
                 let verdict = if skipped { "skipped" } else { "FAILED" };
-                say(multi, format!("{verdict} {id}: {}", n.message)).ok();
+                let line = format!("{verdict} {id}: {}", n.message);
                 notices.push(n);
-                return Ok(if skipped {
+                let outcome = if skipped {
                     Outcome::Skipped
                 } else {
                     Outcome::Failed
-                });
+                };
+                return Ok((outcome, line));
             }
         };
         let inputs = self.prepared.inputs(cell);
@@ -333,23 +349,20 @@ impl CellRenderer<'_> {
         match measured {
             Ok(r) => {
                 render_core::output::write_json(&path, &serde_json::to_value(&r).unwrap())?;
-                say(
-                    multi,
-                    format!(
-                        "{id}: relMSE {:.3e} (unlit) {:.3e} (all), {} spp in {:.2} s",
-                        r.unlit.rel_mse, r.all.rel_mse, r.spp, r.wall_seconds
-                    ),
-                )
-                .ok();
-                Ok(Outcome::Rendered)
+                let line = format!(
+                    "{id}: relMSE {:.3e} (unlit) {:.3e} (all), {} spp in {:.2} s",
+                    r.unlit.rel_mse, r.all.rel_mse, r.spp, r.wall_seconds
+                );
+                Ok((Outcome::Rendered, line))
             }
             Err(message) => {
+                let line = format!("FAILED {id}: {message}");
                 notices.push(Notice {
                     what: format!("cell {id}"),
                     skipped: false,
                     message,
                 });
-                Ok(Outcome::Failed)
+                Ok((Outcome::Failed, line))
             }
         }
     }

@@ -69,7 +69,7 @@ impl Manylights {
         let root = repo_root();
         eprintln!("building manylights (release)…");
         let status = Command::new(env!("CARGO"))
-            .args(["build", "--release", "--quiet", "-p", "manylights"])
+            .args(["build", "--release", "-p", "manylights"])
             .current_dir(&root)
             .status()
             .map_err(|e| format!("cannot run cargo: {e}"))?;
