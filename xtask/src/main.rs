@@ -14,7 +14,7 @@ fn main() -> std::process::ExitCode {
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] [--publish] …    render an experiment (default `quick`) into out/NAME/ (git-ignored; --publish: the committed results/NAME/; see xtask/README.md)\n  merge-results [--experiment NAME] [--publish] [SHARD_DIRS…]    merge shard results and regenerate the report\n  report --experiment NAME [--publish]    rebuild the report (table.md, plots, strips, index.html) from a local run's cell files\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  flip IMAGE.exr REFERENCE.exr [--mask M.png]… [--map OUT.png] [--json]    HDR-ꟻLIP of a render against a reference (the harness's metric)\n  fuzz [--minutes N] [--seed S] [--case K]    fuzz the scene loaders (crates/scene-fuzz) for N minutes\n  glossy-mask SCENE W H OUT.png [--max-alpha A] [--subpixels N] [--footprint R] [--no-emitter-px]    mask of the pixels whose camera rays see GGX α < A (the authors' objects: --subpixels 16 --footprint 1 --no-emitter-px)"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] [--publish] …    render an experiment (default `quick`) into out/NAME/ (git-ignored; --publish: the committed results/NAME/; see xtask/README.md)\n  merge-results [--experiment NAME] [--publish] [SHARD_DIRS…]    merge shard results and regenerate the report\n  report --experiment NAME [--publish]    rebuild the report (table.md, plots, strips, index.html) from a local run's cell files\n  headline [--check] [--readme PATH]    write README.md's headline table (between its headline-table markers) from results/paper/cells.csv\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  flip IMAGE.exr REFERENCE.exr [--mask M.png]… [--map OUT.png] [--json]    HDR-ꟻLIP of a render against a reference (the harness's metric)\n  fuzz [--minutes N] [--seed S] [--case K]    fuzz the scene loaders (crates/scene-fuzz) for N minutes\n  glossy-mask SCENE W H OUT.png [--max-alpha A] [--subpixels N] [--footprint R] [--no-emitter-px]    mask of the pixels whose camera rays see GGX α < A (the authors' objects: --subpixels 16 --footprint 1 --no-emitter-px)"
             );
         }
         Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
@@ -32,7 +32,9 @@ fn main() -> std::process::ExitCode {
             std::process::exit(status.code().unwrap_or(1));
         }
         // issue 6: experiment harness
-        Some("run-experiments" | "merge-results" | "report") => return experiments::main(&args),
+        Some("run-experiments" | "merge-results" | "report" | "headline") => {
+            return experiments::main(&args);
+        }
         // issue 7: every scene on one sheet
         Some("contact-sheet") => return contact_sheet::main(&args),
         Some("glossy-mask") => return glossy_mask::main(&args),

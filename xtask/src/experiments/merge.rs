@@ -2,6 +2,7 @@
 //! results directory, checked (one code state, one reference per scene, no conflicts), and its
 //! report regenerated.
 use super::cell::{CellResult, Notice, read_cell};
+use super::headline;
 use super::paths::{OutputArgs, load_experiment};
 use super::provenance;
 use super::summary::finish;
@@ -45,7 +46,7 @@ pub fn merge(args: MergeArgs) -> Result<ExitCode, String> {
     };
     let copied = merge_into(&args.sources, &out, &mut notices, &perm)?;
     eprintln!("merged {copied} cell files into {}", out.display());
-    finish(
+    let code = finish(
         &exp,
         &out,
         &args.output.references(),
@@ -53,7 +54,11 @@ pub fn merge(args: MergeArgs) -> Result<ExitCode, String> {
         Instant::now(),
         false,
         Some(&perm),
-    )
+    )?;
+    if args.output.publish {
+        headline::after_publish(&exp);
+    }
+    Ok(code)
 }
 
 #[derive(Parser, Debug)]

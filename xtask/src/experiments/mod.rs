@@ -16,6 +16,7 @@ pub mod execute;
 pub mod flip;
 pub mod flip_cells;
 pub mod flip_table;
+pub mod headline;
 #[cfg(test)]
 mod keys_tests;
 pub mod manylights;
@@ -37,7 +38,7 @@ pub mod viewer;
 use clap::Parser;
 use std::process::ExitCode;
 
-/// Entry point of `run-experiments`, `merge-results` and `report`; `args` are the words after `cargo xtask`.
+/// Entry point of `run-experiments`, `merge-results`, `report` and `headline`; `args` are the words after `cargo xtask`.
 pub fn main(args: &[String]) -> ExitCode {
     let result = match args.first().map(String::as_str) {
         Some("run-experiments") => match run::RunArgs::try_parse_from(args) {
@@ -52,6 +53,7 @@ pub fn main(args: &[String]) -> ExitCode {
             Ok(a) => merge::report(a),
             Err(e) => e.exit(),
         },
+        Some("headline") => headline::main(args),
         _ => Err("unknown experiments command".into()),
     };
     match result {

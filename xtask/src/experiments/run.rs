@@ -6,6 +6,7 @@
 use super::code_state;
 use super::config::{self, Experiment};
 use super::execute::{RunOptions, execute};
+use super::headline;
 use super::manylights::{Manylights, repo_root};
 use super::paths::{OutputArgs, experiments_dir, load_experiment, published_dir};
 use super::plan::{self, Cell, Shard};
@@ -100,7 +101,11 @@ pub fn run(args: RunArgs) -> Result<ExitCode, String> {
         );
     }
     let report = (!options.references_only).then_some(&perm);
-    finish(&exp, &out, &refs, done.notices, start, done.failed, report)
+    let code = finish(&exp, &out, &refs, done.notices, start, done.failed, report)?;
+    if args.output.publish && report.is_some() {
+        headline::after_publish(&exp);
+    }
+    Ok(code)
 }
 
 /// `--list`: every experiment, its cell count and how its results stand against today's code.
