@@ -8,7 +8,7 @@ use super::reference::Metric;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
-/// `results/<experiment>/cells/<id>.json`: one finished cell.
+/// `<results>/cells/<id>.json`: one finished cell.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
 pub struct CellResult {
     pub id: String,

@@ -1,10 +1,10 @@
-//! `results/<experiment>/index.html`: the experiment as a page to look at. Per scene the
+//! `<results>/index.html`: the experiment as a page to look at. Per scene the
 //! reference and each strategy at each budget (first seed), flipped or swiped, zoomed and
 //! panned with sharp pixels, re-exposed from linear values, with per-pixel relMSE maps; then
 //! table.md (tables, plots, strips) as HTML. Self-contained: the page, `viewer/<scene>.js`
 //! (the images as data URIs, see [`encode`]) and the PNGs beside it open from the file system
 //! with nothing fetched. Written from the cell files, the renders and the references found on
-//! this machine; without renders (they are not committed) it shows the reference, the
+//! this machine; without renders (a merge of shards that kept none) it shows the reference, the
 //! harness's error maps, the tables and the plots.
 pub mod encode;
 pub mod markdown;
@@ -90,7 +90,7 @@ fn previous_cells(path: &Path) -> std::collections::HashMap<String, Value> {
 /// not an earlier render under the same id.
 fn same_cell(old: &Value, c: &CellResult) -> bool {
     let close = |a: Option<f64>, b: f64| a.is_some_and(|a| (a - b).abs() <= 1e-12 * b.abs());
-    old["spp"].as_u64() == Some(c.spp as u64) && close(old["rel_mse"].as_f64(), c.unlit.rel_mse)
+    old["spp"].as_u64() == Some(c.spp) && close(old["rel_mse"].as_f64(), c.unlit.rel_mse)
 }
 
 /// The data of one scene: what `viewer/<scene>.js` hands to the page.
@@ -165,8 +165,8 @@ fn scene_data(
             if image.is_null()
                 && let Some(old) = previous.get(&c.id).filter(|o| same_cell(o, c))
             {
-                // a checkout without `renders/` (a fresh clone merging results) keeps the
-                // images the committed viewer already has for this very cell
+                // a results directory without `renders/` (shards merged without them) keeps
+                // the images its viewer already has for this very cell
                 image = old["image"].clone();
                 unlit = old["unlit"].clone();
                 flip_map = old["flip_map"].clone();
