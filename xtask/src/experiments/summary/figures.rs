@@ -104,7 +104,8 @@ pub fn write_figures(
             "Plots: relMSE (unlit pixels) vs spp and vs seconds (as above), log-log; the dashed line is the \
              reference's own estimated error. Strips: the reference with the insets marked; per strategy \
              the insets at the highest spp (seed of the first listed), the per-pixel relMSE map \
-             (log scale 1e-4 dark → 10 yellow, grey = the camera sees a light) and the relMSE.\n\n",
+             (log scale 1e-4 dark → 10 yellow, grey = the camera sees a light) and the relMSE; they are \
+             in index.html beside this file (written by every run, not committed).\n\n",
         );
         md.push_str(&figures);
     }

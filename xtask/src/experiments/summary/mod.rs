@@ -59,8 +59,9 @@ pub fn generate(
     figures::write_figures(&mut md, &layout, &cells, out, refs_dir)?;
     write_notices(&mut md, notices);
     write_missing(&mut md, exp, &cells);
+    let table = without_strips(&md);
     render_core::output::write_atomically(&out.join("table.md"), |tmp| {
-        std::fs::write(tmp, &md).map_err(|e| e.to_string())
+        std::fs::write(tmp, &table).map_err(|e| e.to_string())
     })?;
     viewer::write(
         exp,
@@ -105,6 +106,27 @@ pub fn finish(
     } else {
         ExitCode::SUCCESS
     })
+}
+
+/// table.md as committed: the page shows the comparison strips, table.md does not link them
+/// (they are written on every run and not committed, so the links would not resolve in a
+/// clone); the plots stay.
+pub fn without_strips(md: &str) -> String {
+    let mut out = String::with_capacity(md.len());
+    let mut skip_blank = false;
+    for line in md.split_inclusive('\n') {
+        if line.starts_with("![") && line.contains("](strips/") {
+            skip_blank = true;
+            continue;
+        }
+        if skip_blank && line.trim().is_empty() {
+            skip_blank = false;
+            continue;
+        }
+        skip_blank = false;
+        out.push_str(line);
+    }
+    out
 }
 
 /// cells.csv and cells.json: every finished cell.

@@ -135,3 +135,13 @@ fn report_from_cell_files() {
     assert!(md.contains("rendered by **commit abc**"), "{md}");
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn table_md_links_the_plots_not_the_strips() {
+    let md =
+        "## Plots\n\n![s: convergence](plots/s.png)\n\n![s: comparison](strips/s.png)\n\n## Next\n";
+    assert_eq!(
+        without_strips(md),
+        "## Plots\n\n![s: convergence](plots/s.png)\n\n## Next\n"
+    );
+}
