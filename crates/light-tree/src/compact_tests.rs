@@ -2,7 +2,8 @@
 //! positive wherever the exact one is and close to it, both lane implementations
 //! bit-identical, and the compact descents equal to the generic ones bit for bit.
 
-use crate::compact::{LEAF_BIT, pair_importance, quad_importance, slots_importance};
+use crate::codes::{LEAF_BIT, slots_importance};
+use crate::compact::{pair_importance, quad_importance};
 use crate::lanes::{Fast, Fast8, Portable, Scalar4};
 use crate::tests::{Layout, eight_wide_importance, rand_lights, rand_receiver, tree_configs};
 use crate::{DescentSimd, LightTree, NodeId, Rescaled};

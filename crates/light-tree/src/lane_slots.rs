@@ -2,7 +2,7 @@
 //! that one N-lane pass evaluates them all (`QuadNode`: a node's four grandchildren; `OctNode`:
 //! its eight great-grandchildren).
 
-use crate::compact::{LEAF_BIT, Slot, Slots};
+use crate::codes::{LEAF_BIT, Slot, Slots};
 
 /// N slots, structure of arrays.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -68,6 +68,7 @@
 #![warn(missing_docs)]
 
 mod build;
+mod codes;
 mod compact;
 #[cfg(test)]
 mod compact_tests;
@@ -87,12 +88,11 @@ mod split_tests;
 #[cfg(test)]
 mod tests;
 
+pub use codes::{MIN_DIST_SQ, MIN_EMIT_COS};
 pub use cone::Cone;
 pub use oct_descent::{DescentSimd, LaneCache};
 pub use quad_descent::{NO_NODE, QuadView, QuadWeights};
-pub use query::{
-    Cut, DescentRandom, Fresh, MIN_DIST_SQ, MIN_EMIT_COS, Rescaled, SplitCriterion, SplitParams,
-};
+pub use query::{Cut, DescentRandom, Fresh, Rescaled, SplitCriterion, SplitParams};
 pub use sg::{
     SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,
 };

@@ -10,7 +10,7 @@
 //! (`oct_descent.rs`): the binary descent in which interior nodes at the two depths between
 //! weigh as the sum of their lanes.
 
-use crate::compact::{LEAF_BIT, Slot, Slots};
+use crate::codes::{LEAF_BIT, Slot, Slots};
 use crate::lane_slots::LaneSlots;
 use crate::{NO_NODE, Node, NodeId};
 

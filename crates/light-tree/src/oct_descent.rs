@@ -20,7 +20,7 @@
 //!
 //! [`Rescaled`]: crate::Rescaled
 
-use crate::compact::{LEAF_BIT, receiver_pair, slots_evaluated_for, slots_importance};
+use crate::codes::{LEAF_BIT, receiver_pair, slots_evaluated_for, slots_importance};
 use crate::lanes::{Fast8, Lanes};
 use crate::oct::TwoOcts;
 use crate::query::{DescentRandom, choose, chosen, sanitize};

@@ -9,7 +9,7 @@
 //! by its own importance: the binary descent in which an odd-depth interior node weighs as
 //! the sum of its children's importances (see `compact_tests.rs`).
 
-use crate::compact::{LEAF_BIT, Slot};
+use crate::codes::{LEAF_BIT, Slot};
 use crate::lane_slots::LaneSlots;
 use crate::{NO_NODE, Node, NodeId};
 

@@ -9,7 +9,7 @@
 //! weighs as the sum of its children's sanitised weights. An odd-depth start takes one binary
 //! step between its two children first.
 
-use crate::compact::LEAF_BIT;
+use crate::codes::LEAF_BIT;
 use crate::query::{DescentRandom, choose, chosen, sanitize};
 use crate::{LightTree, NodeId};
 

@@ -1,16 +1,9 @@
 //! Queries: node importance, stochastic descent and its pmf replay, cuts.
 
-use crate::compact::LEAF_BIT;
+use crate::codes::{LEAF_BIT, MIN_DIST_SQ, MIN_EMIT_COS};
 use crate::{LightTree, Node, NodeId};
 use glam::Vec3;
 use std::collections::VecDeque;
-
-/// Floor of the squared distance in the importance: keeps Φ/d² finite when x sits exactly on
-/// a point light (r = 0).
-pub const MIN_DIST_SQ: f32 = 1e-12;
-/// Emitter cosine used where θ′ < θe but cos θ′ ≤ 0 (possible only for θe > π/2): keeps such
-/// emitters sampleable instead of giving them zero importance.
-pub const MIN_EMIT_COS: f32 = 1e-3;
 
 /// Source of the random decisions in a descent.
 ///
