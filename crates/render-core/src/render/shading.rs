@@ -1,0 +1,81 @@
+//! A camera ray's shading: the emission it sees, the strategy's estimate at its hit and the
+//! distant lights there.
+use crate::bsdf::Bsdf;
+use crate::camera::Camera;
+use crate::estimator::{DirectLighting, SampleContext, ShadingPoint};
+use crate::rng::SampleStream;
+use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
+use glam::{Vec2, Vec3};
+
+/// What one camera ray found: the emission it sees, the strategy's direct-lighting estimate and
+/// the distant lights at its hit (kept apart so that extra emission rays can replace the first).
+#[derive(Default)]
+pub(super) struct CameraSample {
+    pub(super) emitted: Vec3,
+    pub(super) direct: Vec3,
+    pub(super) distant: Vec3,
+    pub(super) sees_light: bool,
+}
+
+/// Camera-ray shading: emission seen directly plus direct lighting at the hit.
+pub(super) fn shade_camera_sample(
+    scene: &Scene,
+    strategy: &dyn DirectLighting,
+    camera: &Camera,
+    aspect: f32,
+    film: Vec2,
+    rng: &mut SampleStream,
+    ctx: &mut SampleContext,
+) -> CameraSample {
+    let dir = camera.ray_direction(film, aspect);
+    ctx.counters.camera_rays += 1;
+    let Some(hit) = scene.intersect(camera.position, dir, 0.0, f32::INFINITY) else {
+        return CameraSample::default();
+    };
+    let wo = -dir;
+    let mut out = CameraSample::default();
+    if hit.light != NO_LIGHT {
+        out.emitted = scene.lights[hit.light as usize].emitted(hit.ng, hit.uv, wo);
+        out.sees_light = out.emitted != Vec3::ZERO;
+    }
+    let Some(sp) = shading_point(scene, hit, wo) else {
+        return out;
+    };
+    ctx.counters.shading_points += 1;
+    ctx.counters.glossy_points += !sp.bsdf.is_pure_diffuse() as u64;
+    out.direct = strategy.estimate(scene, &sp, rng, ctx);
+    out.distant = distant_lighting(scene, &sp, ctx);
+    out
+}
+
+/// Directional lights, each a delta: one shadow ray apiece.
+fn distant_lighting(scene: &Scene, sp: &ShadingPoint, ctx: &mut SampleContext) -> Vec3 {
+    let mut l = Vec3::ZERO;
+    for d in &scene.distant_lights {
+        let f = sp.bsdf.eval_cos(sp.wo, d.direction) * d.irradiance;
+        if f == Vec3::ZERO {
+            continue;
+        }
+        ctx.counters.shadow_rays += 1;
+        if !scene.accel.occluded(
+            sp.origin_towards(d.direction),
+            d.direction,
+            0.0,
+            f32::INFINITY,
+        ) {
+            l += f;
+        }
+    }
+    l
+}
+
+/// A surface hit for tests and tools that shade points directly.
+pub fn shading_point(scene: &Scene, hit: SurfaceHit, wo: Vec3) -> Option<ShadingPoint> {
+    let m = hit.material?;
+    let params = scene.materials[m as usize].params_at(hit.uv);
+    Some(ShadingPoint {
+        hit,
+        wo,
+        bsdf: Bsdf::new(hit.ns, hit.ng, wo, params),
+    })
+}

@@ -1,0 +1,83 @@
+//! One work unit of a pass: one sample of each of its pixels, accumulated in sample order.
+use super::accum::PixelAccum;
+use super::pass_job::{PassJob, UNIT_PIXELS};
+use super::shading::{CameraSample, shade_camera_sample};
+use crate::estimator::{MAX_AUX, SampleContext};
+use crate::rng::SampleStream;
+use crate::splat::PassSample;
+use crate::stats::Counters;
+
+impl PassJob<'_> {
+    /// Sample `sample_index` of the pixels of work unit `u`, accumulated into `unit` and, when
+    /// splatting, kept in `splats` for the pass's gather.
+    pub(super) fn render_unit(
+        &self,
+        u: usize,
+        (sample_index, pass_weight): (u64, f64),
+        (unit, splats): (&mut [PixelAccum], &mut [PassSample]),
+        c: &mut Counters,
+    ) {
+        for (i, px) in unit.iter_mut().enumerate() {
+            let index = u * UNIT_PIXELS + i;
+            let mut rng = self.in_grid(
+                index,
+                SampleStream::with_sampler(
+                    self.settings.sampler,
+                    self.settings.seed,
+                    index as u64,
+                    sample_index,
+                )
+                .with_pixel_samples(self.settings.spp.unwrap_or(0)),
+            );
+            let (on_film, film, weight) = self.film_position(index, &mut rng);
+            // Fixed before the sample is drawn, from the pixel's earlier passes only.
+            let rays = self.settings.emission_rays.rays_for(px.split);
+            let mut ctx = SampleContext {
+                counters: c,
+                aux: [0.0; MAX_AUX],
+                pixel_memory: &mut px.memory,
+            };
+            let CameraSample {
+                emitted,
+                direct,
+                distant,
+                sees_light,
+            } = shade_camera_sample(
+                self.scene,
+                self.strategy,
+                &self.settings.camera,
+                self.aspect,
+                film,
+                &mut rng,
+                &mut ctx,
+            );
+            let aux = ctx.aux;
+            // Exact for the weight-1 filters (box, triangle).
+            let l = if rays == 1 {
+                ((emitted + direct) + distant) * weight
+            } else {
+                let (sum, lit) = self.extra_emission(index, sample_index, rays, c);
+                px.extra_rays += rays - 1;
+                px.extra_lit += lit;
+                (direct + distant) * weight + (emitted * weight + sum) / rays as f32
+            };
+            // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
+            for k in 0..3 {
+                let v = l[k] as f64;
+                px.sum[k] += pass_weight * v;
+                px.sum_sq[k] += pass_weight * (v * v);
+            }
+            px.light_hits += sees_light as u32;
+            for (acc, v) in px.aux.iter_mut().zip(aux).take(self.n_aux) {
+                *acc += v as f64;
+            }
+            if let Some(s) = splats.get_mut(i) {
+                *s = PassSample {
+                    radiance: l,
+                    film: on_film,
+                    sees_light,
+                };
+            }
+        }
+    }
+}
