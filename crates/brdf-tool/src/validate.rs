@@ -132,28 +132,86 @@ pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
     sab / (saa * sbb).sqrt()
 }
 
+/// The four methods under test, in [`METHODS`] order.
+struct Methods {
+    sptd: Sptd,
+    ltc: Ltc,
+    sptd_oat: Sptd,
+    sptd_near: Sptd,
+}
+
+impl Methods {
+    fn new() -> Methods {
+        Methods {
+            sptd: Sptd::default(),
+            ltc: Ltc::default(),
+            sptd_oat: Sptd::default().intersection(Intersection::OatSander),
+            sptd_near: Sptd::default().lookup(Lookup::Nearest),
+        }
+    }
+
+    /// Each method's integral of the lobe (`wo`, `alpha`) over `cap`.
+    fn cap(&self, wo: Vec3, alpha: f32, cap: &Cap) -> [f64; 4] {
+        [
+            self.sptd.lobe(wo, alpha).integral(cap.axis, cap.cos_theta) as f64,
+            self.ltc.lobe(wo, alpha).integral(cap.axis, cap.cos_theta) as f64,
+            self.sptd_oat
+                .lobe(wo, alpha)
+                .integral(cap.axis, cap.cos_theta) as f64,
+            self.sptd_near
+                .lobe(wo, alpha)
+                .integral(cap.axis, cap.cos_theta) as f64,
+        ]
+    }
+
+    /// Each method's directional albedo of the lobe.
+    fn hemisphere(&self, wo: Vec3, alpha: f32) -> [f64; 4] {
+        [
+            self.sptd.hemisphere(wo, alpha) as f64,
+            self.ltc.hemisphere(wo, alpha) as f64,
+            self.sptd_oat.hemisphere(wo, alpha) as f64,
+            self.sptd_near.hemisphere(wo, alpha) as f64,
+        ]
+    }
+}
+
+/// One shading point's directional albedo: α, θo in degrees, reference, its standard error,
+/// the methods' values.
+type HemiRow = (f32, f32, f64, f64, [f64; 4]);
+/// One shading point's rank correlations: α, θo in degrees, each method's ρ.
+type SpearRow = (f32, f32, [f64; 4]);
+
+/// Runs the three comparisons with `samples` reference samples per cap and writes
+/// `accuracy.csv` and `accuracy.md` into `out`.
 pub fn run(samples: usize, out: &Path) -> Result<(), String> {
     let t0 = Instant::now();
-    let sptd = Sptd::default();
-    let sptd_oat = Sptd::default().intersection(Intersection::OatSander);
-    let sptd_near = Sptd::default().lookup(Lookup::Nearest);
-    let ltc = Ltc::default();
-    let eval = |wo: Vec3, alpha: f32, cap: &Cap| -> [f64; 4] {
-        [
-            sptd.lobe(wo, alpha).integral(cap.axis, cap.cos_theta) as f64,
-            ltc.lobe(wo, alpha).integral(cap.axis, cap.cos_theta) as f64,
-            sptd_oat.lobe(wo, alpha).integral(cap.axis, cap.cos_theta) as f64,
-            sptd_near.lobe(wo, alpha).integral(cap.axis, cap.cos_theta) as f64,
-        ]
-    };
+    let methods = Methods::new();
     let mut points = Vec::new();
     for &alpha in &ALPHAS {
         for &th in &THETAS_DEG {
             points.push((alpha, th));
         }
     }
-    // 1. grid of caps
-    let rows: Vec<Row> = points
+    let rows = cap_grid(&methods, &points, samples);
+    let hemi = hemispheres(&methods, &points, samples);
+    let spear = rank_correlations(&methods, &points, samples);
+    let secs = t0.elapsed().as_secs_f64();
+
+    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    write_file(&out.join("accuracy.csv"), &csv(&rows, &hemi))?;
+    let mut md = String::new();
+    md_header(&mut md, samples, secs, &rows);
+    md_caps(&mut md, &rows);
+    md_hemisphere(&mut md, &hemi);
+    md_spearman(&mut md, samples, &spear);
+    write_file(&out.join("accuracy.md"), &md)?;
+    print!("{md}");
+    Ok(())
+}
+
+/// 1. The grid of caps: every position and half-angle at every shading point.
+fn cap_grid(methods: &Methods, points: &[(f32, f32)], samples: usize) -> Vec<Row> {
+    points
         .par_iter()
         .flat_map_iter(|&(alpha, th)| {
             let wo = ggx::wo_from_theta(th.to_radians());
@@ -172,30 +230,36 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
                         cap,
                         reference: r as f64,
                         ref_se: se as f64,
-                        values: eval(wo, alpha, &cap),
+                        values: methods.cap(wo, alpha, &cap),
                     });
                 }
             }
             rows.into_iter()
         })
-        .collect();
-    // 2. hemisphere
-    let hemi: Vec<(f32, f32, f64, f64, [f64; 4])> = points
+        .collect()
+}
+
+/// 2. The hemisphere: each shading point's directional albedo.
+fn hemispheres(methods: &Methods, points: &[(f32, f32)], samples: usize) -> Vec<HemiRow> {
+    points
         .par_iter()
         .map(|&(alpha, th)| {
             let wo = ggx::wo_from_theta(th.to_radians());
             let (a, se) = reference::hemisphere(wo, alpha, samples * 4);
-            let v = [
-                sptd.hemisphere(wo, alpha) as f64,
-                ltc.hemisphere(wo, alpha) as f64,
-                sptd_oat.hemisphere(wo, alpha) as f64,
-                sptd_near.hemisphere(wo, alpha) as f64,
-            ];
-            (alpha, th, a as f64, se as f64, v)
+            (
+                alpha,
+                th,
+                a as f64,
+                se as f64,
+                methods.hemisphere(wo, alpha),
+            )
         })
-        .collect();
-    // 3. Spearman over random cap sets per shading point
-    let spear: Vec<(f32, f32, [f64; 4])> = points
+        .collect()
+}
+
+/// 3. Spearman's ρ over random cap sets per shading point.
+fn rank_correlations(methods: &Methods, points: &[(f32, f32)], samples: usize) -> Vec<SpearRow> {
+    points
         .par_iter()
         .enumerate()
         .map(|(k, &(alpha, th))| {
@@ -204,21 +268,11 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
             let mut refs = Vec::new();
             let mut vals: [Vec<f64>; 4] = Default::default();
             for c in 0..SPEARMAN_CAPS {
-                let axis = if c % 2 == 0 {
-                    sample_lobe_dir(alpha, wo, &mut rng)
-                } else {
-                    // uniform over z > −0.3 (some caps cross or sit below the horizon)
-                    let z = -0.3 + 1.3 * rng.next_f64();
-                    let r = (1.0 - z * z).max(0.0).sqrt();
-                    let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
-                    DVec3::new(r * phi.cos(), r * phi.sin(), z)
-                };
-                let ang = (0.005f64.ln() + rng.next_f64() * (0.5f64.ln() - 0.005f64.ln())).exp();
-                let cap = Cap64::new(axis, ang.cos()).to32();
+                let cap = random_cap(c, alpha, wo, &mut rng);
                 let (r, _) =
                     reference::cap_integral_seeded(wo, alpha, &cap, samples / 4, 31 + c as u64);
                 refs.push(r as f64);
-                let v = eval(wo, alpha, &cap);
+                let v = methods.cap(wo, alpha, &cap);
                 for m in 0..4 {
                     vals[m].push(v[m]);
                 }
@@ -229,11 +283,26 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
             }
             (alpha, th, rho)
         })
-        .collect();
-    let secs = t0.elapsed().as_secs_f64();
+        .collect()
+}
 
-    // CSV
-    std::fs::create_dir_all(out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+/// Cap `c` of a shading point's random set: even ones around a lobe sample, odd ones uniform.
+fn random_cap(c: usize, alpha: f32, wo: Vec3, rng: &mut SplitMix64) -> Cap {
+    let axis = if c % 2 == 0 {
+        sample_lobe_dir(alpha, wo, rng)
+    } else {
+        // uniform over z > −0.3 (some caps cross or sit below the horizon)
+        let z = -0.3 + 1.3 * rng.next_f64();
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let phi = 2.0 * std::f64::consts::PI * rng.next_f64();
+        DVec3::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let ang = (0.005f64.ln() + rng.next_f64() * (0.5f64.ln() - 0.005f64.ln())).exp();
+    Cap64::new(axis, ang.cos()).to32()
+}
+
+/// `accuracy.csv`: one line per grid cap, then one per shading point's hemisphere.
+fn csv(rows: &[Row], hemi: &[HemiRow]) -> String {
     let mut csv = String::from(
         "alpha,theta_o_deg,position,half_angle,cap_x,cap_y,cap_z,cap_cos,reference,reference_se",
     );
@@ -241,7 +310,7 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
         write!(csv, ",{m}").unwrap();
     }
     csv.push('\n');
-    for r in &rows {
+    for r in rows {
         write!(
             csv,
             "{},{},{},{},{},{},{},{},{:.6e},{:.3e}",
@@ -262,7 +331,7 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
         }
         csv.push('\n');
     }
-    for h in &hemi {
+    for h in hemi {
         write!(
             csv,
             "{},{},hemisphere,{},0,0,1,0,{:.6e},{:.3e}",
@@ -278,10 +347,11 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
         }
         csv.push('\n');
     }
-    write_file(&out.join("accuracy.csv"), &csv)?;
+    csv
+}
 
-    // Markdown
-    let mut md = String::new();
+/// The report's title and what it measured.
+fn md_header(md: &mut String, samples: usize, secs: f64, rows: &[Row]) {
     writeln!(md, "# brdf-integrals accuracy\n").unwrap();
     writeln!(
         md,
@@ -300,19 +370,27 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
         rows.len()
     )
     .unwrap();
+}
+
+/// The cap integrals' error tables: all, by position, by roughness.
+fn md_caps(md: &mut String, rows: &[Row]) {
     writeln!(md, "## Cap integrals, all positions\n").unwrap();
-    table(&mut md, &rows, |_| true);
+    table(md, rows, |_| true);
     for pos in POSITIONS {
         writeln!(md, "\n## Position `{pos}`\n").unwrap();
-        table(&mut md, &rows, |r| r.position == pos);
+        table(md, rows, |r| r.position == pos);
     }
     writeln!(md, "\n## By roughness (all positions)\n").unwrap();
     for (lo, hi) in [(0.0, 0.0101), (0.0101, 0.26), (0.26, 1.01)] {
         writeln!(md, "\nα in [{lo}, {hi}):\n").unwrap();
-        table(&mut md, &rows, |r| {
+        table(md, rows, |r| {
             (r.alpha as f64) >= lo && (r.alpha as f64) < hi
         });
     }
+}
+
+/// The directional albedo's error table.
+fn md_hemisphere(md: &mut String, hemi: &[HemiRow]) {
     writeln!(
         md,
         "\n## Hemisphere (directional albedo), floor: relative error ≤ 2 %\n"
@@ -343,6 +421,10 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
         )
         .unwrap();
     }
+}
+
+/// The rank correlations: per method, then per shading point.
+fn md_spearman(md: &mut String, samples: usize, spear: &[SpearRow]) {
     writeln!(
         md,
         "\n## Spearman rank correlation with the reference, floor ≥ 0.95\n"
@@ -385,9 +467,6 @@ pub fn run(samples: usize, out: &Path) -> Result<(), String> {
         }
         writeln!(md).unwrap();
     }
-    write_file(&out.join("accuracy.md"), &md)?;
-    print!("{md}");
-    Ok(())
 }
 
 fn sample_lobe_dir(alpha: f32, wo: Vec3, rng: &mut SplitMix64) -> DVec3 {
