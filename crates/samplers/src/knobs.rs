@@ -4,7 +4,7 @@
 use crate::StrategyOptions;
 use crate::brdf_oriented::{BoImportance, BrdfIntegral};
 use crate::learned::{LearnTarget, PassWeights};
-use crate::rivals::slc::SlcDescent;
+use crate::rivals::slc_minmax::SlcDescent;
 
 /// What a knob's flag takes.
 #[derive(Clone, Copy, Debug)]

@@ -52,7 +52,7 @@ pub fn strategies() -> &'static [&'static Strategy] {
     registry::STRATEGIES
 }
 
-/// Builds the strategy called `name` for `scene` (its parameters: [`resolve::resolved_parameters`]).
+/// Builds the strategy called `name` for `scene` (its parameters: [`registry::resolved_parameters`]).
 pub fn create(
     name: &str,
     scene: &Scene,

@@ -1,9 +1,22 @@
 //! The knobs every strategy reads its parameters from ([`StrategyOptions`]), their defaults and
 //! the checks every strategy applies to them. Each knob's flag and help are in [`crate::knobs`].
-use crate::tree_selection::PowerUnits;
 use crate::{brdf_oriented, learned};
 use light_tree::{SplitCriterion, SplitParams};
 use serde::{Deserialize, Serialize};
+
+/// The unit of the power the tree aggregates.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum PowerUnits {
+    /// Watts, one unit for every kind of light ([`render_core::light::Light::power`]).
+    #[default]
+    Watts,
+    /// The authors' `LeWithArea` (`--reproduce`): luminance × area for area lights (no π,
+    /// one side), the intensity's luminance for point and spot lights.
+    Authors,
+}
+
+/// Stochastic lightcuts' cut size K in its paper's tables.
+pub const DEFAULT_CUT_SIZE: usize = 32;
 
 /// Knobs of the strategies, each with its default; strategies ignore the ones they do not use.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -60,7 +73,7 @@ pub struct StrategyOptions {
     /// Stochastic lightcuts: most nodes in a cut (K), one shadow ray each (the paper's 32).
     pub slc_cut_size: usize,
     /// Stochastic lightcuts: how a cut node's light is drawn down its subtree.
-    pub slc_descent: crate::rivals::slc::SlcDescent,
+    pub slc_descent: crate::rivals::slc_minmax::SlcDescent,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
     pub learned: learned::LearnedConfig,
 }
@@ -129,7 +142,7 @@ impl Default for StrategyOptions {
             binary_bo_descent: false,
             pilot: true,
             adaptive_split: true,
-            slc_cut_size: crate::rivals::slc::DEFAULT_CUT_SIZE,
+            slc_cut_size: DEFAULT_CUT_SIZE,
             slc_descent: Default::default(),
             learned: learned::LearnedConfig::default(),
         }

@@ -2,7 +2,10 @@
 //! [`Strategy`] value in its own file and one line here.
 use crate::strategy::Strategy;
 use crate::tree_selection as tree;
-use crate::{StrategyError, brdf_oriented, learned, light_strategy, oracle, ris, rivals, sg};
+use crate::{
+    StrategyError, StrategyOptions, brdf_oriented, learned, light_strategy, oracle, ris, rivals, sg,
+};
+use serde_json::Value;
 
 /// The registry.
 pub static STRATEGIES: &[&Strategy] = &[
@@ -53,9 +56,17 @@ pub fn find(name: &str) -> Result<&'static Strategy, StrategyError> {
         })
 }
 
+/// Every parameter strategy `name` renders with under `opts` (an object; `{}` for the
+/// strategies without parameters), or the error [`crate::create`] would give for them.
+pub fn resolved_parameters(name: &str, opts: &StrategyOptions) -> Result<Value, StrategyError> {
+    crate::check_options(opts)?;
+    Ok((find(name)?.resolve)(name, opts))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use serde_json::json;
 
     #[test]
     fn names_are_unique_and_each_finds_itself() {
@@ -116,5 +127,60 @@ mod tests {
                 .unwrap()
                 .reproduce
         );
+    }
+
+    #[test]
+    fn every_listed_strategy_resolves() {
+        for s in crate::strategies() {
+            assert!(
+                resolved_parameters(s.name, &StrategyOptions::default()).is_ok(),
+                "{}",
+                s.name
+            );
+        }
+    }
+
+    #[test]
+    fn defaults_are_filled_in_and_options_reach_only_their_strategies() {
+        let d = StrategyOptions::default();
+        let ek = resolved_parameters("tree-split+bsdf", &d).unwrap();
+        assert_eq!(ek["split"]["tau"], json!(crate::DEFAULT_TAU));
+        assert_eq!(ek["split"]["max_cut"], json!(d.max_cut));
+        let mis = resolved_parameters("mis3-adaptive", &d).unwrap();
+        assert_eq!(mis["method"]["n_max"], json!(d.n_max));
+        // n_max is the method's alone: E&K's parameters do not move with it, the method's do
+        let other = StrategyOptions {
+            n_max: d.n_max + 1,
+            ..d.clone()
+        };
+        assert_eq!(resolved_parameters("tree-split+bsdf", &other).unwrap(), ek);
+        assert_ne!(resolved_parameters("mis3-adaptive", &other).unwrap(), mis);
+        // reproduce resolves τ to the authors' and changes the cut for E&K too
+        let r = StrategyOptions {
+            reproduce: true,
+            ..d.clone()
+        };
+        let ek_r = resolved_parameters("tree-split+bsdf", &r).unwrap();
+        assert_eq!(ek_r["split"]["tau"], json!(crate::AUTHORS_TAU));
+        assert_eq!(ek_r["split"]["max_cut"], Value::Null);
+        assert_eq!(
+            resolved_parameters("power+bsdf", &r).unwrap(),
+            json!({}),
+            "power sampling takes none of the options"
+        );
+    }
+
+    #[test]
+    fn every_listed_strategy_resolves_and_bad_input_is_an_error() {
+        let d = StrategyOptions::default();
+        for s in crate::strategies() {
+            assert!(resolved_parameters(s.name, &d).is_ok(), "{}", s.name);
+        }
+        assert!(matches!(
+            resolved_parameters("nope", &d),
+            Err(StrategyError::Unknown { .. })
+        ));
+        let bad = StrategyOptions { lambda: -1.0, ..d };
+        assert!(resolved_parameters("tree", &bad).is_err());
     }
 }

@@ -15,16 +15,7 @@ use render_core::scene::Scene;
 use std::cell::RefCell;
 use std::collections::VecDeque;
 
-/// The unit of the power the tree aggregates.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum PowerUnits {
-    /// Watts, one unit for every kind of light ([`render_core::light::Light::power`]).
-    #[default]
-    Watts,
-    /// The authors' `LeWithArea` (`--reproduce`): luminance × area for area lights (no π,
-    /// one side), the intensity's luminance for point and spot lights.
-    Authors,
-}
+pub use crate::options::PowerUnits;
 
 /// The bounds the tree is built over, one per scene light, in scene order.
 pub fn light_bounds(scene: &Scene, units: PowerUnits) -> Vec<LightBounds> {

@@ -26,21 +26,7 @@ use std::path::{Path, PathBuf};
 
 /// Circles known and broken elsewhere, as the set of files of their strongly connected part
 /// (the test also fails once one of them is gone, so that the list only holds live ones).
-const ALLOWED: &[(&str, &[&str])] = &[
-    // broken on branch results; remove at merge
-    (
-        "xtask",
-        &["src/experiments/provenance.rs", "src/experiments/report.rs"],
-    ),
-    // broken on branch results; remove at merge
-    (
-        "xtask",
-        &[
-            "src/experiments/summary.rs",
-            "src/experiments/viewer/mod.rs",
-        ],
-    ),
-];
+const ALLOWED: &[(&str, &[&str])] = &[];
 
 #[test]
 fn no_module_circles_in_the_workspace() {

@@ -131,7 +131,7 @@ impl StrategyArgs {
     /// covered by its `scene_hash`): what the render's
     /// JSON records as `resolved_strategy`.
     pub fn resolved(&self) -> anyhow::Result<serde_json::Value> {
-        let parameters = samplers::resolve::resolved_parameters(&self.strategy, &self.options()?)?;
+        let parameters = samplers::registry::resolved_parameters(&self.strategy, &self.options()?)?;
         Ok(serde_json::json!({
             "strategy": self.strategy,
             "parameters": parameters,

@@ -102,8 +102,7 @@ use render_core::scene::Scene;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
-/// The paper's cut size K (issue 50: "K = 32 in the paper's tables").
-pub const DEFAULT_CUT_SIZE: usize = 32;
+pub use crate::options::DEFAULT_CUT_SIZE;
 /// The largest cut size accepted (one shadow ray per node).
 pub const MAX_CUT_SIZE: usize = 1 << 16;
 /// Floor of the box distance in the error bound, as a fraction of the root's bounding radius.
