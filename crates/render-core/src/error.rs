@@ -28,8 +28,13 @@ pub enum SceneError {
     BadLight { what: String, message: String },
     #[error("camera `{0}` not found in the scene")]
     CameraNotFound(String),
-    #[error("unknown built-in scene `{name}` (known: {known})")]
-    UnknownBuiltin { name: String, known: String },
+    /// `suggestion`: empty, or "; did you mean `x`?" ([`crate::suggest::did_you_mean`]).
+    #[error("unknown built-in scene `{name}`{suggestion} (known: {known})")]
+    UnknownBuiltin {
+        name: String,
+        suggestion: String,
+        known: String,
+    },
     #[error("bad parameter `{key}` for built-in scene `{scene}`: {message}")]
     BadBuiltinParam {
         scene: String,

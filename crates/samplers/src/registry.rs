@@ -50,7 +50,7 @@ pub fn find(name: &str) -> Result<&'static Strategy, StrategyError> {
             let names: Vec<&str> = STRATEGIES.iter().map(|s| s.name).collect();
             StrategyError::Unknown {
                 name: name.into(),
-                suggestion: render_core::suggest::did_you_mean(name, &names),
+                suggestion: render_core::suggest::did_you_mean(name, names.iter().copied()),
                 known: names.join(", "),
             }
         })

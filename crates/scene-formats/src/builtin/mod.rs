@@ -24,6 +24,7 @@ use rand_pcg::Pcg32;
 use render_core::error::SceneError;
 use render_core::material::Material;
 use render_core::scene::{Scene, SceneBuilder};
+use render_core::suggest::did_you_mean;
 use std::f32::consts::PI;
 
 /// What `manylights scenes` prints about one built-in scene.
@@ -248,6 +249,7 @@ impl Params {
                 .find(|d| d.name == name)
                 .ok_or_else(|| SceneError::UnknownBuiltin {
                     name: name.into(),
+                    suggestion: did_you_mean(name, SCENES.iter().map(|d| d.name)),
                     known: known(),
                 })?;
         let mut values: Vec<(&'static str, String)> = def
@@ -275,7 +277,10 @@ impl Params {
             let slot = values
                 .iter_mut()
                 .find(|(name, _)| *name == k)
-                .ok_or_else(|| bad(k, format!("unknown key (valid keys: {})", valid())))?;
+                .ok_or_else(|| {
+                    let hint = did_you_mean(k, def.keys.iter().map(|k| k.name));
+                    bad(k, format!("unknown key{hint} (valid keys: {})", valid()))
+                })?;
             if seen.contains(&k) {
                 return Err(bad(k, "given twice".into()));
             }

@@ -171,6 +171,16 @@ fn unknown_scenes_are_rejected_with_the_known_names() {
 }
 
 #[test]
+fn misspelt_scene_names_and_keys_get_a_suggestion() {
+    let e = err(load_builtin("builtin:cornel")).to_string();
+    assert!(e.contains("did you mean `cornell`?"), "{e}");
+    let e = err(load_builtin("builtin:zzzzzzzz")).to_string();
+    assert!(!e.contains("did you mean"), "{e}");
+    let e = err(load_builtin("builtin:glossy-spheres?light=10")).to_string();
+    assert!(e.contains("did you mean `lights`?"), "{e}");
+}
+
+#[test]
 fn specs_parse_with_and_without_prefix_and_scientific_counts() {
     let p = Params::parse("builtin:glossy-spheres?lights=1e3&seed=3").unwrap();
     assert_eq!(p.lights().unwrap(), 1000);
