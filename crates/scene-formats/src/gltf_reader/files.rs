@@ -1,13 +1,14 @@
 //! The files a glTF names: each must be a regular file, and its URI must decode.
 use std::path::Path;
 
-/// An error unless `path` is a regular file (reading a device or a pipe whole never ends).
+/// An error unless `path` is a regular file (reading a device or a pipe whole never ends); the
+/// message does not name the file, the caller's error does.
 pub(crate) fn regular_file(path: &Path) -> Result<(), String> {
-    let meta = std::fs::metadata(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
     if meta.is_file() {
         Ok(())
     } else {
-        Err(format!("{} is not a regular file", path.display()))
+        Err("not a regular file".into())
     }
 }
 

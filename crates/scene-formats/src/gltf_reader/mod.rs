@@ -211,7 +211,7 @@ pub fn add_gltf(
         if let Some(file) = external_file(base, uri).map_err(|e| gltf_err(path, e))?
             && file.exists()
         {
-            regular_file(&file).map_err(|e| gltf_err(path, e))?;
+            regular_file(&file).map_err(|e| gltf_err(path, format!("{}: {e}", file.display())))?;
         }
     }
     drop(raw);

@@ -274,6 +274,16 @@ fn bad_input_gives_a_clear_error() {
     let missing = temp_path("does-not-exist.glb");
     let e = err(load_gltf(&missing, None));
     assert!(matches!(e, SceneError::Io { .. }), "{e}");
+    // Each reader names a missing file once.
+    for name in [
+        "does-not-exist.glb",
+        "does-not-exist.toml",
+        "does-not-exist.pbrt",
+    ] {
+        let missing = temp_path(name);
+        let e = err(crate::load_scene(missing.to_str().unwrap(), None)).to_string();
+        assert_eq!(e.matches(name).count(), 1, "{e}");
+    }
 
     let garbage = temp_path("garbage.glb");
     std::fs::write(

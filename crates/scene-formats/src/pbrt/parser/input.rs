@@ -55,31 +55,25 @@ impl Parser<'_> {
         } else {
             self.base_dir.join(name)
         };
-        let fail = |this: &Self, message: String| match line {
-            Some(l) => this.err(l, message),
+        // An included file is named after the including file's line; the main file is named
+        // once, by the `Io` error itself.
+        let fail = |this: &Self, what: &str, detail: String| match line {
+            Some(l) => this.err(l, format!("{what}{}: {detail}", path.display())),
             None => SceneError::Io {
                 path: path.display().to_string(),
-                message: message.clone(),
+                message: detail,
             },
         };
         if path.extension().is_some_and(|e| e == "gz") {
-            return Err(fail(
-                self,
-                format!(
-                    "{}: gzip-compressed files are not supported (gunzip it first)",
-                    path.display()
-                ),
-            ));
+            let detail = "gzip-compressed files are not supported (gunzip it first)";
+            return Err(fail(self, "", detail.into()));
         }
-        let file = File::open(&path)
-            .map_err(|e| fail(self, format!("cannot open {}: {e}", path.display())))?;
+        let file = File::open(&path).map_err(|e| fail(self, "cannot open ", e.to_string()))?;
         let canonical = path.canonicalize().unwrap_or_else(|_| path.clone());
         if let Some(k) = self.sources.iter().position(|s| s.canonical == canonical) {
             let chain: Vec<&str> = self.sources[k..].iter().map(|s| s.shown.as_str()).collect();
-            return Err(fail(
-                self,
-                format!("Include cycle: {} → {}", chain.join(" → "), path.display()),
-            ));
+            let cycle = format!("Include cycle: {} → {}", chain.join(" → "), path.display());
+            return Err(self.err(line.unwrap_or(0), cycle));
         }
         self.sources.push(Source {
             tokens: Tokenizer::new(BufReader::with_capacity(1 << 18, file)),
