@@ -8,8 +8,9 @@
 //! [`light_tree::LightTree`] built from the host's light bounds, a
 //! [`brdf_oriented::importance::BoRecord::from_parts`] (position, frame, GGX lobe from
 //! `brdf-integrals`, lobe weights), [`brdf_oriented::technique::BoState::select_from`] with any
-//! source of uniform numbers and `selection_pmf` for MIS; `examples/bo_from_raw.rs` does it,
-//! and its samples pass the chi-square test in the tests. The crate still depends on
+//! source of uniform numbers and `selection_pmf` for MIS; the `embedding-example` crate
+//! (crates/embedding-example, `cargo run --release -p embedding-example`) does it, and its
+//! samples pass the chi-square test in its tests. The crate still depends on
 //! `render-core` for `Frame`, `Vec3` and, in the strategies, scenes, lights and `SampleStream`:
 //! splitting the renderer-agnostic techniques into a crate of their own needs `Frame` moved
 //! down (to `light-tree` or a small geometry crate), a point-on-light callback in place of

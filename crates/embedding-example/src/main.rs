@@ -5,8 +5,8 @@
 //! `render_core`'s `Frame` and `Vec3` (glam) name the geometry, see the crate's docs.
 //!
 //! It draws lights by BO, compares their frequencies with the probabilities
-//! `BoState::selection_pmf` gives (chi-square), and prints the test. `cargo run -p samplers
-//! --example bo_from_raw`; the crate's tests run it too (tests/embedding_example.rs).
+//! `BoState::selection_pmf` gives (chi-square), and prints the test. `cargo run --release -p
+//! embedding-example`; `cargo test -p embedding-example` runs it too, with a check.
 use brdf_integrals::CapIntegral;
 use light_tree::{LightBounds, LightTree};
 use rand::{RngExt, SeedableRng};
@@ -18,15 +18,15 @@ use samplers::brdf_oriented::technique::BoState;
 
 /// What one run found: the chi-square outcome, the sum of the pmf over the lights, and how
 /// many lights the BO cut has as clusters.
-pub struct Outcome {
-    pub chi2: chi2_test::Chi2Outcome,
-    pub pmf_sum: f64,
-    pub clusters: usize,
+struct Outcome {
+    chi2: chi2_test::Chi2Outcome,
+    pmf_sum: f64,
+    clusters: usize,
 }
 
 /// `n_lights` small spherical lights spread over a ceiling, `samples` BO selections at one
 /// glossy shading point.
-pub fn run(n_lights: usize, samples: usize, seed: u64) -> Outcome {
+fn run(n_lights: usize, samples: usize, seed: u64) -> Outcome {
     let mut rng = Pcg32::seed_from_u64(seed);
     // The host's lights, as bounds: a sphere of radius r is a box, every normal (θo = π).
     let r = 0.02;
@@ -82,11 +82,23 @@ pub fn run(n_lights: usize, samples: usize, seed: u64) -> Outcome {
     }
 }
 
-#[allow(dead_code)]
 fn main() {
     let o = run(500, 200_000, 7);
     println!(
         "BO cut: {} clusters; Σ pmf = {:.6}; chi-square {:.1} on {} dof, p = {:.3}",
         o.clusters, o.pmf_sum, o.chi2.statistic, o.chi2.dof, o.chi2.p_value
     );
+}
+
+#[cfg(test)]
+mod tests {
+    /// Its BO samples pass the chi-square test against their own pmf, as our renderer's do.
+    #[test]
+    fn bo_from_raw_inputs_matches_its_pmf() {
+        let o = super::run(300, 100_000, 11);
+        assert!((o.pmf_sum - 1.0).abs() < 1e-4, "Σ pmf = {}", o.pmf_sum);
+        assert!(o.clusters > 1, "a glossy point splits the cut");
+        assert!(o.chi2.dof > 20, "{:?}", o.chi2);
+        assert!(o.chi2.p_value > 1e-4, "{:?}", o.chi2);
+    }
 }
