@@ -14,6 +14,8 @@ pub mod composition;
 pub mod gltf_reader;
 pub mod gltf_writer;
 pub mod pbrt;
+#[cfg(test)]
+mod test_notice;
 
 use render_core::SceneError;
 use render_core::scene::Scene;

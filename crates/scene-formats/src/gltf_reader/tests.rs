@@ -488,7 +488,7 @@ fn shared_scene(rel: &str) -> Option<PathBuf> {
     if p.exists() {
         Some(p)
     } else {
-        eprintln!("skipped: {} is not present", p.display());
+        crate::test_notice::skipped(&format!("the checks of {rel}"));
         None
     }
 }

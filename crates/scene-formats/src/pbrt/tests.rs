@@ -468,7 +468,7 @@ fn bisml_cornell_pbrt_loads_like_its_gltf() {
         "/../../../shared/scenes/bisml_cornell"
     ));
     if !dir.exists() {
-        eprintln!("skipped: {} is not present", dir.display());
+        crate::test_notice::skipped("bisml_cornell_pbrt_loads_like_its_gltf");
         return;
     }
     let (scene, report) = load_pbrt_with_report(&dir.join("pbrt/scene.pbrt"), None).unwrap();
