@@ -9,11 +9,30 @@ fn manylights(args: &[&str]) -> Output {
         .expect("binary runs")
 }
 
-fn temp_dir(name: &str) -> PathBuf {
+/// A fresh directory under the system's temporary directory, removed with everything in it
+/// when dropped (kept when the test fails, to look at).
+struct TempDir(PathBuf);
+
+impl std::ops::Deref for TempDir {
+    type Target = Path;
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.0);
+        }
+    }
+}
+
+fn temp_dir(name: &str) -> TempDir {
     let d = std::env::temp_dir().join(format!("manylights-cli-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&d);
     std::fs::create_dir_all(&d).unwrap();
-    d
+    TempDir(d)
 }
 
 const SCENE: &str = "builtin:glossy-spheres?lights=64";
