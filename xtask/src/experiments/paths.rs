@@ -34,8 +34,9 @@ pub fn load_experiment(name: &str) -> Result<Experiment, String> {
             })
             .unwrap_or_default();
         names.sort();
+        let hint = render_core::suggest::did_you_mean(name, names.iter().map(String::as_str));
         return Err(format!(
-            "no experiment `{name}` ({} does not exist); experiments: {}",
+            "no experiment `{name}`{hint} ({} does not exist; experiments: {})",
             path.display(),
             names.join(", ")
         ));
