@@ -63,9 +63,11 @@ if ! msg=$(sbatch --test-only "$@" "${common[@]}" --wrap true 2>&1); then
 Set CPUS_PER_TASK (CPUs per job) or TIME_LIMIT, or pick another --partition."
 fi
 
+# xtask builds manylights itself: `cargo build -p xtask -p manylights` would unify their
+# dependencies' features into another set and build manylights a second time.
 refs=$(sbatch --parsable "$@" "${common[@]}" --job-name=manylights-refs \
     --output="$logs/%x-%j.out" \
-    --wrap "cargo build --release -p xtask -p manylights && cargo xtask run-experiments --experiment $experiment --references-only --threads $cpus ${XTASK_FLAGS:-}")
+    --wrap "cargo build --release -p xtask && cargo xtask run-experiments --experiment $experiment --references-only --threads $cpus$flags")
 array=$(sbatch --parsable "$@" "${common[@]}" --dependency=afterok:"$refs" --array=1-"$n" \
     --output="$logs/%x-%A_%a.out" \
     "$(dirname "$0")/run-experiments.sbatch" "$experiment")
