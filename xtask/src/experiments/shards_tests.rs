@@ -219,21 +219,32 @@ fn shards_merged_equal_the_single_run() {
 }
 
 /// Runs `script` (under xtask/slurm/) with bash, `args` and `env`, with stand-ins for `cargo`
-/// and `sbatch` that record their arguments (one call a line) in `base/calls`.
+/// and `sbatch` that record their arguments (one call a line) in `base/calls`, and for the
+/// Slurm queries: `sinfo` (one node of 8 CPUs) and `squeue`, `scontrol`, `scancel` (nothing
+/// pending), so that a Slurm installed on the machine is never asked.
 fn run_script(base: &Path, script: &str, args: &[&str], env: &[(&str, &str)]) -> Vec<String> {
     let bin = base.join("bin");
     std::fs::create_dir_all(&bin).unwrap();
     let calls = base.join("calls");
     let _ = std::fs::remove_file(&calls);
-    for tool in ["cargo", "sbatch"] {
-        // sbatch answers a job id, as with --parsable
-        let body = format!(
-            "#!/bin/sh\necho \"{tool} $*\" >> '{}'\n[ {tool} = sbatch ] && echo 4$(wc -l < '{}' | tr -d ' ')\nexit 0\n",
-            calls.display(),
-            calls.display()
-        );
+    let c = calls.display();
+    let stubs = [
+        ("cargo", format!("echo \"cargo $*\" >> '{c}'")),
+        // a submission answers a job id, as with --parsable (41, 42, …); --test-only nothing
+        (
+            "sbatch",
+            format!(
+                "echo \"sbatch $*\" >> '{c}'\ncase \"$*\" in *--parsable*) echo 4$(grep -c -- --parsable '{c}');; esac"
+            ),
+        ),
+        ("sinfo", "echo 8".to_string()),
+        ("squeue", String::new()),
+        ("scontrol", String::new()),
+        ("scancel", String::new()),
+    ];
+    for (tool, body) in stubs {
         let p = bin.join(tool);
-        std::fs::write(&p, body).unwrap();
+        std::fs::write(&p, format!("#!/bin/sh\n{body}\nexit 0\n")).unwrap();
         use std::os::unix::fs::PermissionsExt;
         std::fs::set_permissions(&p, std::fs::Permissions::from_mode(0o755)).unwrap();
     }
@@ -325,6 +336,15 @@ fn slurm_scripts_run_one_shard_per_task_then_merge() {
     );
     // submit.sh: the references, then the array (after them), then the merge (after it)
     let calls = run_script(&base, "submit.sh", &["paper", "4", "--partition=cpu"], &[]);
+    // first a dry run that Slurm refuses if no node can ever take the jobs
+    assert!(
+        calls[0].starts_with("sbatch --test-only --partition=cpu --cpus-per-task=8"),
+        "{calls:?}"
+    );
+    let calls: Vec<String> = calls
+        .into_iter()
+        .filter(|c| c.contains("--parsable"))
+        .collect();
     assert_eq!(calls.len(), 3, "{calls:?}");
     assert!(
         calls
