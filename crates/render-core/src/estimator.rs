@@ -95,6 +95,11 @@ pub trait DirectLighting: Send + Sync {
     fn techniques(&self) -> Vec<&'static str> {
         Vec::new()
     }
+    /// The counters of its own it adds to in `Counters::strategy`, in that order (at most
+    /// `MAX_STRATEGY_COUNTERS`).
+    fn counters(&self) -> Vec<crate::stats::StrategyCounter> {
+        Vec::new()
+    }
     /// Names of the per-pixel diagnostic channels written to `SampleContext::aux`.
     fn aux_channels(&self) -> Vec<&'static str> {
         Vec::new()

@@ -3,6 +3,18 @@ use serde::Serialize;
 
 /// Most techniques a strategy can report sample counts for.
 pub const MAX_TECHNIQUES: usize = 8;
+/// Most counters of its own a strategy can declare.
+pub const MAX_STRATEGY_COUNTERS: usize = 8;
+
+/// A counter a strategy declares: its name, and what its mean is taken per: the shading points
+/// (`None`) or the total of another of its counters (e.g. the points where one technique ran).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StrategyCounter {
+    /// Its name in `render --stats` and the render's JSON.
+    pub name: &'static str,
+    /// The name of the counter it is a mean per, or `None`: per shading point.
+    pub per: Option<&'static str>,
+}
 
 #[derive(Clone, Copy, Debug, Default, Serialize, PartialEq)]
 pub struct Counters {
@@ -16,16 +28,8 @@ pub struct Counters {
     pub shading_points: u64,
     /// Samples drawn per technique, in the order of `DirectLighting::techniques`.
     pub technique_samples: [u64; MAX_TECHNIQUES],
-    /// Shading points whose BSDF has a glossy lobe (where BRDF-oriented sampling runs).
-    pub glossy_points: u64,
-    /// Light-selection work summed over shading points (all, and glossy ones only): clusters
-    /// of the E&K (LS) cut, clusters of the BRDF-oriented (BO) cut, and BRDF-aware samples
-    /// (BO samples + BRDF samples).
-    pub ls_clusters: u64,
-    pub ls_clusters_glossy: u64,
-    pub bo_clusters: u64,
-    pub brdf_aware_samples: u64,
-    pub brdf_aware_samples_glossy: u64,
+    /// The strategy's own counters, in the order of `DirectLighting::counters`.
+    pub strategy: [u64; MAX_STRATEGY_COUNTERS],
 }
 
 impl Counters {
@@ -38,50 +42,34 @@ impl Counters {
         for (a, b) in self.technique_samples.iter_mut().zip(o.technique_samples) {
             *a += b;
         }
-        self.glossy_points += o.glossy_points;
-        self.ls_clusters += o.ls_clusters;
-        self.ls_clusters_glossy += o.ls_clusters_glossy;
-        self.bo_clusters += o.bo_clusters;
-        self.brdf_aware_samples += o.brdf_aware_samples;
-        self.brdf_aware_samples_glossy += o.brdf_aware_samples_glossy;
-    }
-
-    /// Records one shading point's light-selection work (`glossy`: its BSDF has a glossy lobe).
-    pub fn record_selection(
-        &mut self,
-        glossy: bool,
-        ls_clusters: usize,
-        bo_clusters: usize,
-        brdf_aware: usize,
-    ) {
-        self.ls_clusters += ls_clusters as u64;
-        self.bo_clusters += bo_clusters as u64;
-        self.brdf_aware_samples += brdf_aware as u64;
-        if glossy {
-            self.ls_clusters_glossy += ls_clusters as u64;
-            self.brdf_aware_samples_glossy += brdf_aware as u64;
+        for (a, b) in self.strategy.iter_mut().zip(o.strategy) {
+            *a += b;
         }
     }
 
-    /// Means per shading point and per glossy point of the light-selection work, as JSON:
-    /// `{"per_shading_point": {ls_clusters, bo_clusters, brdf_aware_samples},
-    ///   "per_glossy_point": {…}, "glossy_points": n}`.
-    pub fn selection_means(&self) -> serde_json::Value {
-        let per = |v: u64, n: u64| if n > 0 { v as f64 / n as f64 } else { 0.0 };
-        let (n, g) = (self.shading_points, self.glossy_points);
-        serde_json::json!({
-            "shading_points": n,
-            "glossy_points": g,
-            "per_shading_point": {
-                "ls_clusters": per(self.ls_clusters, n),
-                "bo_clusters": per(self.bo_clusters, n),
-                "brdf_aware_samples": per(self.brdf_aware_samples, n),
-            },
-            "per_glossy_point": {
-                "ls_clusters": per(self.ls_clusters_glossy, g),
-                "bo_clusters": per(self.bo_clusters, g),
-                "brdf_aware_samples": per(self.brdf_aware_samples_glossy, g),
-            },
-        })
+    /// The strategy's counters as JSON, each with its total, what its mean is per and the mean:
+    /// `{name: {"total": n, "per": "shading point" | other counter, "mean": x}}`.
+    pub fn strategy_means(&self, names: &[StrategyCounter]) -> serde_json::Value {
+        let total = |name: &str| {
+            names
+                .iter()
+                .position(|c| c.name == name)
+                .map_or(0, |i| self.strategy[i])
+        };
+        let map: serde_json::Map<String, serde_json::Value> = names
+            .iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let n = c.per.map_or(self.shading_points, total);
+                let mean = if n > 0 { self.strategy[i] as f64 / n as f64 } else { 0.0 };
+                let v = serde_json::json!({
+                    "total": self.strategy[i],
+                    "per": c.per.unwrap_or("shading point"),
+                    "mean": mean,
+                });
+                (c.name.to_string(), v)
+            })
+            .collect();
+        serde_json::Value::Object(map)
     }
 }

@@ -4,6 +4,12 @@
 //! Every technique can both sample a light point and evaluate the density of any light point,
 //! so strategies combine them by multiple importance sampling.
 //!
+//! **Layout.** One folder per family: [`baselines`] (uniform, power, BSDF, the light trees, the
+//! oracles), [`brdf_oriented`] (the paper's method), [`learned`] (the learned selections),
+//! [`ris`] (per-pixel resampling) and [`rivals`] (this round's tree rivals). At the root: the
+//! [`registry`] of every [`Strategy`], the [`knobs`] they read from [`StrategyOptions`], and the
+//! pieces several families share (MIS weights, BSDF sampling, the work counters).
+//!
 //! **Embedding BRDF-oriented sampling elsewhere.** The BO technique runs from raw inputs: a
 //! [`light_tree::LightTree`] built from the host's light bounds, a
 //! [`brdf_oriented::importance::BoRecord::from_parts`] (position, frame, GGX lobe from
@@ -22,27 +28,26 @@
 #![warn(missing_docs)]
 
 pub mod alias;
+pub mod baselines;
 pub mod brdf_oriented;
 pub mod bsdf_sampling;
 pub mod convergence;
 pub mod knobs;
 pub mod learned;
-pub mod light_strategy;
 mod memo;
 pub mod mis;
 mod options;
-pub mod oracle;
 pub mod point_sets;
 pub mod registry;
 pub mod resolve;
 pub mod ris;
 pub mod rivals;
 mod scratch;
-pub mod selection;
-pub mod sg;
 pub mod strategy;
-pub mod tree_selection;
+pub mod work_counters;
 
+/// The baselines' modules, by their short paths.
+pub use baselines::{light_strategy, oracle, selection, sg, tree_selection};
 pub use options::{AUTHORS_TAU, DEFAULT_TAU, StrategyError, StrategyOptions, check_options};
 use render_core::estimator::DirectLighting;
 use render_core::scene::Scene;

@@ -198,23 +198,18 @@ fn selection_counters_are_recorded() {
     let d = StrategyOptions::default();
     let r = render_opts(&scene, "mis3-adaptive", &d, 2, 3, Some((24, 18)));
     let c = &r.counters;
-    assert!(
-        c.glossy_points > 0 && c.glossy_points < c.shading_points,
-        "{c:?}"
-    );
-    assert!(c.ls_clusters >= c.shading_points);
-    assert!(c.ls_clusters_glossy <= c.ls_clusters);
-    assert!(c.bo_clusters >= c.glossy_points);
+    let [glossy, ls, ls_glossy, bo, aware, aware_glossy] = samplers::work_counters::totals(c);
+    assert!(glossy > 0 && glossy < c.shading_points, "{c:?}");
+    assert!(ls >= c.shading_points);
+    assert!(ls_glossy <= ls);
+    assert!(bo >= glossy);
     // Diffuse points take one BRDF sample, glossy ones at least one BO and one BRDF sample.
-    assert!(c.brdf_aware_samples_glossy >= 2 * c.glossy_points);
-    assert_eq!(
-        c.brdf_aware_samples - c.brdf_aware_samples_glossy,
-        c.shading_points - c.glossy_points
-    );
+    assert!(aware_glossy >= 2 * glossy);
+    assert_eq!(aware - aware_glossy, c.shading_points - glossy);
     let e = render_opts(&scene, "tree-split+bsdf", &d, 2, 3, Some((24, 18))).counters;
-    assert_eq!(e.bo_clusters, 0);
-    assert_eq!(e.brdf_aware_samples, e.shading_points);
-    assert!(e.ls_clusters >= e.shading_points);
+    assert_eq!(samplers::work_counters::totals(&e)[3], 0, "E&K has no BO cut");
+    assert_eq!(samplers::work_counters::totals(&e)[4], e.shading_points);
+    assert!(samplers::work_counters::totals(&e)[1] >= e.shading_points);
     let p = StrategyOptions {
         reproduce: true,
         ..d.clone()

@@ -11,6 +11,7 @@ use render_core::output::{write_exr, write_json, write_mask_png, write_png};
 use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
 use render_core::splat::Reconstruction;
+use render_core::stats::StrategyCounter;
 use samplers::StrategyOptions;
 use std::path::{Path, PathBuf};
 
@@ -407,7 +408,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         "rays": { "camera": result.counters.camera_rays, "emission": result.counters.emission_rays, "shadow": result.counters.shadow_rays, "bsdf": result.counters.bsdf_rays },
         "shading_points": result.counters.shading_points,
         "technique_samples": technique_samples,
-        "light_selection": result.counters.selection_means(),
+        "strategy_counters": result.counters.strategy_means(&strategy.counters()),
         "unlit_pixel_fraction": result.light_fraction.iter().filter(|&&f| f == 0.0).count() as f64 / result.light_fraction.len() as f64,
         "aux_files": aux_files,
         "png_exposure": args.png.as_ref().map(|_| exposure),
@@ -433,29 +434,34 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         );
     }
     if args.stats {
-        let c = &result.counters;
-        let per = |v: u64, n: u64| if n > 0 { v as f64 / n as f64 } else { 0.0 };
-        let (n, g) = (c.shading_points, c.glossy_points);
-        eprintln!(
-            "CPU {:.2} s ({:.3} s per spp); {} shading points, {} glossy ({:.1} %)",
-            result.cpu_seconds.unwrap_or(f64::NAN),
-            result.cpu_seconds.unwrap_or(f64::NAN) / result.spp.max(1) as f64,
-            n,
-            g,
-            100.0 * per(g, n)
-        );
-        eprintln!(
-            "per shading point: LS clusters {:.2}, BO clusters {:.2}, BRDF-aware samples {:.2}",
-            per(c.ls_clusters, n),
-            per(c.bo_clusters, n),
-            per(c.brdf_aware_samples, n)
-        );
-        eprintln!(
-            "per glossy point:  LS clusters {:.2}, BO clusters {:.2}, BRDF-aware samples {:.2}",
-            per(c.ls_clusters_glossy, g),
-            per(c.bo_clusters, g),
-            per(c.brdf_aware_samples_glossy, g)
-        );
+        print_stats(&result, &strategy.counters());
     }
     Ok(())
+}
+
+/// `--stats`: the CPU time and the strategy's own counters, as means per what each is counted per.
+fn print_stats(result: &render_core::render::RenderResult, names: &[StrategyCounter]) {
+    let c = &result.counters;
+    let cpu = result.cpu_seconds.unwrap_or(f64::NAN);
+    eprintln!(
+        "CPU {cpu:.2} s ({:.3} s per spp); {} shading points",
+        cpu / result.spp.max(1) as f64,
+        c.shading_points
+    );
+    let means = c.strategy_means(names);
+    let mut pers: Vec<&str> = Vec::new();
+    for n in names {
+        let per = n.per.unwrap_or("shading point");
+        if !pers.contains(&per) {
+            pers.push(per);
+        }
+    }
+    for per in pers {
+        let line: Vec<String> = names
+            .iter()
+            .filter(|n| n.per.unwrap_or("shading point") == per)
+            .map(|n| format!("{} {:.2}", n.name, means[n.name]["mean"].as_f64().unwrap_or(0.0)))
+            .collect();
+        eprintln!("per {per}: {}", line.join(", "));
+    }
 }

@@ -42,7 +42,6 @@ pub(super) fn shade_camera_sample(
         return out;
     };
     ctx.counters.shading_points += 1;
-    ctx.counters.glossy_points += !sp.bsdf.is_pure_diffuse() as u64;
     out.direct = strategy.estimate(scene, &sp, rng, ctx);
     out.distant = distant_lighting(scene, &sp, ctx);
     out

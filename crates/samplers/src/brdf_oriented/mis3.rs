@@ -217,6 +217,10 @@ where
         v
     }
 
+    fn counters(&self) -> Vec<render_core::stats::StrategyCounter> {
+        crate::work_counters::names()
+    }
+
     fn techniques(&self) -> Vec<&'static str> {
         match self.mode {
             Mis3Mode::BoOnly => vec!["bo"],
@@ -373,8 +377,13 @@ where
             return Vec3::ZERO;
         };
         ctx.counters.technique_samples[0] += 1;
-        ctx.counters
-            .record_selection(!sp.bsdf.is_pure_diffuse(), 0, bo.cut().cut.len(), 1);
+        crate::work_counters::record(
+            ctx.counters,
+            !sp.bsdf.is_pure_diffuse(),
+            0,
+            bo.cut().cut.len(),
+            1,
+        );
         let Some((light, p_sel)) = bo.select(tree, rng, !self.config.reproduce) else {
             return Vec3::ZERO;
         };
@@ -556,7 +565,8 @@ fn record_counts<L: LobeIntegral + LobeDensity>(
 ) {
     let (ls_clusters, bo_clusters) = point.cluster_counts();
     let (n_bo, n_brdf) = (counts.n_bo, counts.n_brdf);
-    ctx.counters.record_selection(
+    crate::work_counters::record(
+        ctx.counters,
         point.bo.is_some(),
         ls_clusters,
         bo_clusters,

@@ -42,6 +42,10 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
         p
     }
 
+    fn counters(&self) -> Vec<render_core::stats::StrategyCounter> {
+        crate::work_counters::names()
+    }
+
     fn techniques(&self) -> Vec<&'static str> {
         if self.with_bsdf {
             vec!["light", "bsdf"]
@@ -60,8 +64,13 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
         let sel = &self.selection;
         let state = sel.prepare(scene, sp);
         sel.clear_observation(&mut ctx.pixel_memory[..]);
-        ctx.counters
-            .record_selection(!sp.bsdf.is_pure_diffuse(), 0, 0, self.with_bsdf as usize);
+        crate::work_counters::record(
+            ctx.counters,
+            !sp.bsdf.is_pure_diffuse(),
+            0,
+            0,
+            self.with_bsdf as usize,
+        );
         // Every number first, in the order the samples use them (a light pick and its point
         // per light sample, then the BSDF sample's), so that the picked lights' records can be
         // fetched while the BSDF ray is traced.

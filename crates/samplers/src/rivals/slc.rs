@@ -480,6 +480,9 @@ impl DirectLighting for Slc {
     fn techniques(&self) -> Vec<&'static str> {
         self.0.techniques()
     }
+    fn counters(&self) -> Vec<render_core::stats::StrategyCounter> {
+        self.0.counters()
+    }
     fn estimate(
         &self,
         scene: &Scene,

@@ -81,6 +81,10 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
         self.parameters.clone()
     }
 
+    fn counters(&self) -> Vec<render_core::stats::StrategyCounter> {
+        crate::work_counters::names()
+    }
+
     fn techniques(&self) -> Vec<&'static str> {
         if self.with_bsdf {
             vec!["light", "bsdf"]
@@ -99,7 +103,8 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
         let state = self.selection.prepare(scene, sp);
         let mut picks = Pooled::<Picks>::take();
         self.selection.pick(&state, sp, rng, &mut picks.0);
-        ctx.counters.record_selection(
+        crate::work_counters::record(
+            ctx.counters,
             !sp.bsdf.is_pure_diffuse(),
             self.selection.clusters(&state),
             0,
