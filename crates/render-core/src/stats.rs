@@ -61,7 +61,11 @@ impl Counters {
             .enumerate()
             .map(|(i, c)| {
                 let n = c.per.map_or(self.shading_points, total);
-                let mean = if n > 0 { self.strategy[i] as f64 / n as f64 } else { 0.0 };
+                let mean = if n > 0 {
+                    self.strategy[i] as f64 / n as f64
+                } else {
+                    0.0
+                };
                 let v = serde_json::json!({
                     "total": self.strategy[i],
                     "per": c.per.unwrap_or("shading point"),

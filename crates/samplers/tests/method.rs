@@ -207,7 +207,11 @@ fn selection_counters_are_recorded() {
     assert!(aware_glossy >= 2 * glossy);
     assert_eq!(aware - aware_glossy, c.shading_points - glossy);
     let e = render_opts(&scene, "tree-split+bsdf", &d, 2, 3, Some((24, 18))).counters;
-    assert_eq!(samplers::work_counters::totals(&e)[3], 0, "E&K has no BO cut");
+    assert_eq!(
+        samplers::work_counters::totals(&e)[3],
+        0,
+        "E&K has no BO cut"
+    );
     assert_eq!(samplers::work_counters::totals(&e)[4], e.shading_points);
     assert!(samplers::work_counters::totals(&e)[1] >= e.shading_points);
     let p = StrategyOptions {

@@ -460,7 +460,13 @@ fn print_stats(result: &render_core::render::RenderResult, names: &[StrategyCoun
         let line: Vec<String> = names
             .iter()
             .filter(|n| n.per.unwrap_or("shading point") == per)
-            .map(|n| format!("{} {:.2}", n.name, means[n.name]["mean"].as_f64().unwrap_or(0.0)))
+            .map(|n| {
+                format!(
+                    "{} {:.2}",
+                    n.name,
+                    means[n.name]["mean"].as_f64().unwrap_or(0.0)
+                )
+            })
             .collect();
         eprintln!("per {per}: {}", line.join(", "));
     }
