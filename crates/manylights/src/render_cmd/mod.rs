@@ -468,6 +468,11 @@ fn print_stats(result: &render_core::render::RenderResult, names: &[StrategyCoun
                 )
             })
             .collect();
-        eprintln!("per {per}: {}", line.join(", "));
+        let header = if per == "shading point" {
+            "per shading point".to_string()
+        } else {
+            format!("per one of the {per}")
+        };
+        eprintln!("{header}: {}", line.join(", "));
     }
 }
