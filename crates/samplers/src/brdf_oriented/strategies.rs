@@ -10,27 +10,7 @@ use render_core::estimator::DirectLighting;
 use render_core::scene::Scene;
 use serde_json::{Value, json};
 
-/// The method's knobs.
-const METHOD_KNOBS: &[&str] = &[
-    "tau",
-    "max-cut",
-    "delta",
-    "n-max",
-    "lambda",
-    "brdf-integral",
-    "bo-importance",
-    "pivot-sphere",
-    "no-adaptive-total",
-    "no-adaptive-split",
-    "weighted-ub",
-    "fixed-n-max",
-    "independent-samples",
-    "split-ls-at-glossy",
-    "binary-bo-descent",
-    "no-pilot",
-];
-
-/// The method's knobs and the learned cluster selection's.
+/// The method's knobs, then the learned cluster selection's (which only the learned variant takes).
 const LEARNED_METHOD_KNOBS: &[&str] = &[
     "tau",
     "max-cut",
@@ -54,6 +34,9 @@ const LEARNED_METHOD_KNOBS: &[&str] = &[
     "learned-defensive",
     "learned-prior",
 ];
+
+/// The method's knobs.
+const METHOD_KNOBS: &[&str] = LEARNED_METHOD_KNOBS.split_at(16).0;
 
 /// `mis3-adaptive`'s camera rays per sample for the emission seen directly: its few spp per
 /// pixel leave the coverage noise of the pixels that see a light (the paper experiment chose it).
