@@ -17,19 +17,7 @@
 
 use render_core::estimator::PIXEL_MEMORY;
 
-/// Slots of the pixel memory used by the tallies.
-pub const SLOT_HITS: usize = 0;
-/// Slot of the BRDF-sampling misses (see [`SLOT_HITS`]).
-pub const SLOT_MISSES: usize = 1;
-/// Slots of the efficiency tally ([`EfficiencyTally`]).
-const SLOT_SAMPLES: usize = 2;
-const SLOT_SUM: usize = 3;
-const SLOT_SUM_SQ: usize = 4;
-const SLOT_WITHIN: usize = 5;
-const SLOT_UNIT: usize = 6;
-const SLOT_UB: usize = 7;
-const SLOT_GLOSSY: usize = 8;
-const SLOT_REST: usize = 9;
+use super::pixel_memory::{GLOSSY, REST, SAMPLES, SUM, SUM_SQ, UB, UNIT, WITHIN};
 
 /// The N_max values [`EfficiencyTally::best_n_max`] chooses from (about √2 apart).
 pub const N_MAX_CANDIDATES: [f32; 16] = [
@@ -62,15 +50,15 @@ impl EfficiencyTally {
         if !within.is_finite() {
             return;
         }
-        memory[SLOT_SAMPLES] += 1.0;
-        memory[SLOT_SUM] += y;
-        memory[SLOT_SUM_SQ] += y * y;
-        memory[SLOT_REST] += rest_cost;
+        memory[SAMPLES] += 1.0;
+        memory[SUM] += y;
+        memory[SUM_SQ] += y * y;
+        memory[REST] += rest_cost;
         if glossy.is_some() {
-            memory[SLOT_WITHIN] += within;
-            memory[SLOT_UNIT] += within * k as f32;
-            memory[SLOT_UB] += ub;
-            memory[SLOT_GLOSSY] += 1.0;
+            memory[WITHIN] += within;
+            memory[UNIT] += within * k as f32;
+            memory[UB] += ub;
+            memory[GLOSSY] += 1.0;
         }
     }
 
@@ -82,24 +70,24 @@ impl EfficiencyTally {
         let mut error_at = [0.0f64; N_MAX_CANDIDATES.len()];
         let mut cost_at = [0.0f64; N_MAX_CANDIDATES.len()];
         for m in memories {
-            let n = m[SLOT_SAMPLES] as f64;
+            let n = m[SAMPLES] as f64;
             if n < 2.0 {
                 continue;
             }
             pixels += 1;
-            let mean = m[SLOT_SUM] as f64 / n;
-            let total = ((m[SLOT_SUM_SQ] as f64 - n * mean * mean) / (n - 1.0)).max(0.0);
+            let mean = m[SUM] as f64 / n;
+            let total = ((m[SUM_SQ] as f64 - n * mean * mean) / (n - 1.0)).max(0.0);
             let w = 1.0 / (mean * mean + 0.01);
-            rest_var += w * (total - m[SLOT_WITHIN] as f64 / n);
+            rest_var += w * (total - m[WITHIN] as f64 / n);
             total_var += w * total;
-            let glossy = m[SLOT_GLOSSY] as f64 / n;
-            let unit = m[SLOT_UNIT] as f64 / n;
-            let ub = if m[SLOT_GLOSSY] > 0.0 {
-                (m[SLOT_UB] / m[SLOT_GLOSSY]) as f64
+            let glossy = m[GLOSSY] as f64 / n;
+            let unit = m[UNIT] as f64 / n;
+            let ub = if m[GLOSSY] > 0.0 {
+                (m[UB] / m[GLOSSY]) as f64
             } else {
                 0.0
             };
-            let rest_cost = m[SLOT_REST] as f64 / n;
+            let rest_cost = m[REST] as f64 / n;
             for (j, &n_max) in N_MAX_CANDIDATES.iter().enumerate() {
                 let k = 2.0 + (n_max as f64) * ub;
                 error_at[j] += w * unit / k;
@@ -142,40 +130,6 @@ pub fn fixed_counts(n: u32, p_bo: f32) -> (u32, u32) {
     (1 + k, 1 + n - k)
 }
 
-/// The authors' sequential counters (`reproduce`).
-#[derive(Clone, Copy, Debug)]
-pub struct InSampleCounters {
-    /// BRDF samples that found no light, plus the prior 1.
-    pub fail: f32,
-    /// λ × BRDF samples that found a light, plus the prior 1.
-    pub success: f32,
-    /// Weight λ of a hit.
-    pub lambda: f32,
-}
-
-impl InSampleCounters {
-    /// Counters at the authors' priors (1, 1).
-    pub fn new(lambda: f32) -> Self {
-        InSampleCounters {
-            fail: 1.0,
-            success: 1.0,
-            lambda,
-        }
-    }
-    /// Counts one BRDF sample's outcome.
-    pub fn record(&mut self, hit: bool) {
-        if hit {
-            self.success += self.lambda;
-        } else {
-            self.fail += 1.0;
-        }
-    }
-    /// P(BO) = n_nohit / (n_nohit + λ·n_hit).
-    pub fn p_bo(&self) -> f32 {
-        self.fail / (self.fail + self.success)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -190,10 +144,6 @@ mod tests {
         assert!((probability_bo(1.0, 3.0, 10.0) - 4.0 / 15.0).abs() < 1e-6);
         assert_eq!(fixed_counts(10, 0.26), (4, 8));
         assert_eq!(fixed_counts(0, 0.9), (1, 1));
-        let mut c = InSampleCounters::new(10.0);
-        c.record(true);
-        c.record(false);
-        assert!((c.p_bo() - 2.0 / 13.0).abs() < 1e-6);
     }
 
     #[test]
@@ -221,6 +171,6 @@ mod tests {
         let mut m = [0.0f32; PIXEL_MEMORY];
         EfficiencyTally::record(&mut m, f32::NAN, 1.0, None);
         EfficiencyTally::record(&mut m, 1.0, 1.0, Some((f32::INFINITY, 2, 1.0)));
-        assert_eq!(m[SLOT_SAMPLES], 0.0);
+        assert_eq!(m[SAMPLES], 0.0);
     }
 }

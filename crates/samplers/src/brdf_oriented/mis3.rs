@@ -1,14 +1,13 @@
 //! The strategies of Liu, Xu & Yan 2019: BO alone, and three-technique MIS (tree-splitting light
 //! sampling LS + BRDF-oriented light sampling BO + BRDF sampling) with equal or adaptive counts.
-use super::allocation::{
-    EfficiencyTally, InSampleCounters, SLOT_HITS, SLOT_MISSES, fixed_counts, probability_bo,
-    total_brdf_aware,
-};
+use super::allocation::{EfficiencyTally, fixed_counts, probability_bo, total_brdf_aware};
 use super::importance::{BoRecord, LobeDensity};
+use super::in_sample::InSampleCounters;
 use super::pivot_sphere::PivotSphere;
+use super::pixel_memory::{HITS, MISSES};
 use super::sg_importance::SgImportance;
 use super::technique::BoState;
-use super::three_techniques::{LEARNED_SLOT, LsState, PointTechniques, Taken};
+use super::three_techniques::{LsState, PointTechniques, Taken};
 pub use super::three_techniques::{TECHNIQUE_BO, TECHNIQUE_BSDF, TECHNIQUE_LS};
 use super::{BoConfig, LobePivot};
 use crate::mis::power_heuristic;
@@ -172,8 +171,8 @@ impl<C: CapIntegral> Mis3<C> {
     fn planned_p_bo(&self, ctx: &SampleContext) -> f32 {
         if self.config.adaptive_split {
             probability_bo(
-                ctx.pixel_memory[SLOT_HITS],
-                ctx.pixel_memory[SLOT_MISSES],
+                ctx.pixel_memory[HITS],
+                ctx.pixel_memory[MISSES],
                 self.config.lambda,
             )
         } else {
@@ -309,7 +308,7 @@ where
             .table
             .write()
             .unwrap_or_else(|e| e.into_inner())
-            .merge_pass(&mut pixels.iter().copied(), LEARNED_SLOT);
+            .merge_pass(&mut pixels.iter().copied(), super::pixel_memory::LEARNED);
         self.learn_n_max(&mut pixels.iter().copied());
     }
 
@@ -546,8 +545,8 @@ where
             let u = strata.map(|(_, lobe, dir)| r3_point(lobe, dir, i));
             hits += point.bsdf_sample(taken, rng, ctx, u) as u32;
         }
-        ctx.pixel_memory[SLOT_HITS] += hits as f32;
-        ctx.pixel_memory[SLOT_MISSES] += (n_brdf - hits) as f32;
+        ctx.pixel_memory[HITS] += hits as f32;
+        ctx.pixel_memory[MISSES] += (n_brdf - hits) as f32;
         Counts {
             n_bo,
             n_brdf,

@@ -14,8 +14,10 @@
 pub mod allocation;
 pub mod cut;
 pub mod importance;
+pub mod in_sample;
 pub mod mis3;
 pub mod pivot_sphere;
+pub mod pixel_memory;
 pub mod quad_importance;
 pub mod sg_importance;
 pub mod strategies;

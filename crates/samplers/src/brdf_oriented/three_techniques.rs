@@ -108,7 +108,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
             let sampled = match &self.ls {
                 LsState::Learned(sel, st) => {
                     let u = rng.next_2d();
-                    let memory = &mut ctx.pixel_memory[LEARNED_SLOT..];
+                    let memory = &mut ctx.pixel_memory[super::pixel_memory::LEARNED..];
                     sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, *sel, st)
                         .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf)))
                 }
@@ -256,11 +256,6 @@ pub enum LsState<'a> {
     /// The learned selection and its cluster probabilities at this point.
     Learned(&'a LearnedSelection, LearnedState),
 }
-
-/// First pixel-memory slot of the learned LS's observation (after the method's own slots).
-pub const LEARNED_SLOT: usize = 10;
-const _: () =
-    assert!(LEARNED_SLOT + crate::learned::regions::SLOTS <= render_core::estimator::PIXEL_MEMORY);
 
 impl LsState<'_> {
     fn pick(&self, sp: &ShadingPoint, rng: &mut SampleStream, picks: &mut Vec<(u32, f32)>) {
