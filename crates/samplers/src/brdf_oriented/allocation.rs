@@ -17,7 +17,14 @@
 
 use render_core::estimator::PIXEL_MEMORY;
 
+use super::importance::LobeDensity;
 use super::pixel_memory::{GLOSSY, REST, SAMPLES, SUM, SUM_SQ, UB, UNIT, WITHIN};
+use super::three_techniques::{PointTechniques, TECHNIQUE_BO, TECHNIQUE_BSDF};
+use crate::point_sets::lattice_sum_variance;
+use brdf_integrals::LobeIntegral;
+use render_core::Vec3;
+use render_core::colour::luminance;
+use render_core::estimator::SampleContext;
 
 /// The N_max values [`EfficiencyTally::best_n_max`] chooses from (about √2 apart).
 pub const N_MAX_CANDIDATES: [f32; 16] = [
@@ -128,6 +135,62 @@ pub fn fixed_counts(n: u32, p_bo: f32) -> (u32, u32) {
     let k = ((n as f32) * p_bo.clamp(0.0, 1.0)).round() as u32;
     let k = k.min(n);
     (1 + k, 1 + n - k)
+}
+
+/// How many samples each BRDF-aware technique took at a shading point.
+pub struct Counts {
+    /// BO samples.
+    pub n_bo: u32,
+    /// BRDF samples.
+    pub n_brdf: u32,
+    /// Heuristic 1's N, the samples beyond the forced ones (the `n_brdf_aware` channel).
+    pub n_extra: u32,
+    /// Whether the samples were stratified sets (`point_sets`).
+    pub stratified: bool,
+}
+
+/// Step 5, learning N_max: the sample's luminance, the rest of its cost and, at a glossy
+/// point, the variance its BRDF-aware samples added, into the pixel's efficiency tally.
+pub fn record_efficiency<L: LobeIntegral + LobeDensity>(
+    point: &PointTechniques<L>,
+    counts: &Counts,
+    l: Vec3,
+    moments: &[[f32; 2]; 3],
+    stratified_bo: bool,
+    bo_terms: &[f32],
+    ctx: &mut SampleContext,
+) {
+    let (n_bo, n_brdf) = (counts.n_bo, counts.n_brdf);
+    // In units of one BRDF-aware sample (a ray, a descent, the other techniques' densities),
+    // the rest costs about two for the camera ray and shading, one per LS cluster and a
+    // quarter per BO cluster (measured: docs/notes/defaults.md).
+    let (ls_clusters, bo_clusters) = point.cluster_counts();
+    let rest_cost = 2.0 + ls_clusters as f32 + 0.25 * bo_clusters as f32;
+    let glossy = point.bo.as_ref().map(|b| {
+        // The variance the BRDF-aware samples added: n_t times the spread of one term of
+        // technique t (its samples without contribution count as zeros). Stratified BO
+        // samples: collapsed strata (`lattice_sum_variance`), as the spread over all strata
+        // would count the differences between them; the R3 set of BRDF samples has no such
+        // neighbours, and keeps the spread (an overestimate).
+        let mut within = 0.0;
+        if stratified_bo {
+            within += lattice_sum_variance(bo_terms);
+        }
+        for (t, n_t) in [(TECHNIQUE_BO, n_bo), (TECHNIQUE_BSDF, n_brdf)] {
+            if t == TECHNIQUE_BO && stratified_bo {
+                continue;
+            }
+            let [sum, sum_sq] = moments[t];
+            let var = if n_t >= 2 {
+                ((sum_sq - sum * sum / n_t as f32) / (n_t - 1) as f32).max(0.0)
+            } else {
+                sum_sq
+            };
+            within += n_t as f32 * var;
+        }
+        (within, n_bo + n_brdf, b.cut().upper_bound())
+    });
+    EfficiencyTally::record(&mut ctx.pixel_memory[..], luminance(l), rest_cost, glossy);
 }
 
 #[cfg(test)]

@@ -1,8 +1,10 @@
 //! The strategies of Liu, Xu & Yan 2019: BO alone, and three-technique MIS (tree-splitting light
 //! sampling LS + BRDF-oriented light sampling BO + BRDF sampling) with equal or adaptive counts.
-use super::allocation::{EfficiencyTally, fixed_counts, probability_bo, total_brdf_aware};
+use super::allocation::{
+    Counts, EfficiencyTally, fixed_counts, probability_bo, record_efficiency, total_brdf_aware,
+};
 use super::importance::{BoRecord, LobeDensity};
-use super::in_sample::InSampleCounters;
+use super::in_sample::in_sample_allocation;
 use super::pivot_sphere::PivotSphere;
 use super::pixel_memory::{HITS, MISSES};
 use super::sg_importance::SgImportance;
@@ -11,7 +13,7 @@ use super::three_techniques::{LsState, PointTechniques, Taken};
 pub use super::three_techniques::{TECHNIQUE_BO, TECHNIQUE_BSDF, TECHNIQUE_LS};
 use super::{BoConfig, LobePivot};
 use crate::mis::power_heuristic;
-use crate::point_sets::{lattice_1d, lattice_sum_variance, r3_point};
+use crate::point_sets::{lattice_1d, r3_point};
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
@@ -349,16 +351,6 @@ where
     }
 }
 
-/// How many samples each BRDF-aware technique took at a shading point.
-struct Counts {
-    n_bo: u32,
-    n_brdf: u32,
-    /// Heuristic 1's N, the samples beyond the forced ones (the `n_brdf_aware` channel).
-    n_extra: u32,
-    /// Whether the samples were stratified sets (`point_sets`).
-    stratified: bool,
-}
-
 impl<C: CapIntegral> Mis3<C>
 where
     C::Lobe: LobePivot + LobeDensity,
@@ -456,7 +448,15 @@ where
             (Some(b), _) => {
                 let n = self.total_brdf_aware(b);
                 if self.config.reproduce {
-                    self.in_sample_allocation(point, n, taken, rng, ctx)
+                    in_sample_allocation(
+                        point,
+                        n,
+                        self.config.lambda,
+                        self.config.adaptive_split,
+                        taken,
+                        rng,
+                        ctx,
+                    )
                 } else {
                     self.fixed_allocation(point, n, taken, rng, ctx)
                 }
@@ -478,45 +478,6 @@ where
             self.config.n_max as f32
         };
         total_brdf_aware(ub, n_max, self.config.adaptive_total)
-    }
-
-    /// The authors' in-sample loop (`reproduce`; biased: the outcomes pick the counts), with
-    /// their one random number rescaled at every step.
-    fn in_sample_allocation(
-        &self,
-        point: &PointTechniques<C::Lobe>,
-        n: u32,
-        taken: &mut Vec<Taken>,
-        rng: &mut SampleStream,
-        ctx: &mut SampleContext,
-    ) -> Counts {
-        let mut c = InSampleCounters::new(self.config.lambda);
-        point.bo_sample(taken, rng, ctx, 0, None);
-        c.record(point.bsdf_sample(taken, rng, ctx, None));
-        let (mut n_bo, mut n_brdf) = (1, 1);
-        let mut u = rng.next_f32();
-        for _ in 0..n {
-            let p = if self.config.adaptive_split {
-                c.p_bo()
-            } else {
-                0.5
-            };
-            if u < p {
-                point.bo_sample(taken, rng, ctx, 0, None);
-                n_bo += 1;
-                u /= p;
-            } else {
-                c.record(point.bsdf_sample(taken, rng, ctx, None));
-                n_brdf += 1;
-                u = (u - p) / (1.0 - p);
-            }
-        }
-        Counts {
-            n_bo,
-            n_brdf,
-            n_extra: n,
-            stratified: false,
-        }
     }
 
     /// Our default: counts fixed before drawing, from earlier samples of this pixel, then the
@@ -621,48 +582,4 @@ fn mis_weighted_sum(
         }
     }
     (l, moments)
-}
-
-/// Step 5, learning N_max: the sample's luminance, the rest of its cost and, at a glossy
-/// point, the variance its BRDF-aware samples added, into the pixel's efficiency tally.
-fn record_efficiency<L: LobeIntegral + LobeDensity>(
-    point: &PointTechniques<L>,
-    counts: &Counts,
-    l: Vec3,
-    moments: &[[f32; 2]; 3],
-    stratified_bo: bool,
-    bo_terms: &[f32],
-    ctx: &mut SampleContext,
-) {
-    let (n_bo, n_brdf) = (counts.n_bo, counts.n_brdf);
-    // In units of one BRDF-aware sample (a ray, a descent, the other techniques' densities),
-    // the rest costs about two for the camera ray and shading, one per LS cluster and a
-    // quarter per BO cluster (measured: docs/notes/defaults.md).
-    let (ls_clusters, bo_clusters) = point.cluster_counts();
-    let rest_cost = 2.0 + ls_clusters as f32 + 0.25 * bo_clusters as f32;
-    let glossy = point.bo.as_ref().map(|b| {
-        // The variance the BRDF-aware samples added: n_t times the spread of one term of
-        // technique t (its samples without contribution count as zeros). Stratified BO
-        // samples: collapsed strata (`lattice_sum_variance`), as the spread over all strata
-        // would count the differences between them; the R3 set of BRDF samples has no such
-        // neighbours, and keeps the spread (an overestimate).
-        let mut within = 0.0;
-        if stratified_bo {
-            within += lattice_sum_variance(bo_terms);
-        }
-        for (t, n_t) in [(TECHNIQUE_BO, n_bo), (TECHNIQUE_BSDF, n_brdf)] {
-            if t == TECHNIQUE_BO && stratified_bo {
-                continue;
-            }
-            let [sum, sum_sq] = moments[t];
-            let var = if n_t >= 2 {
-                ((sum_sq - sum * sum / n_t as f32) / (n_t - 1) as f32).max(0.0)
-            } else {
-                sum_sq
-            };
-            within += n_t as f32 * var;
-        }
-        (within, n_bo + n_brdf, b.cut().upper_bound())
-    });
-    EfficiencyTally::record(&mut ctx.pixel_memory[..], luminance(l), rest_cost, glossy);
 }
