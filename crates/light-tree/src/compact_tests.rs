@@ -461,7 +461,8 @@ fn caller_weighted_quad_descent_matches_the_generic_one() {
             let node = tree.node(id);
             match node.children(id) {
                 Some((l, r)) if node.depth() % 2 == 1 => {
-                    crate::query::sanitize(weight(l)) + crate::query::sanitize(weight(r))
+                    crate::descent_step::sanitize(weight(l))
+                        + crate::descent_step::sanitize(weight(r))
                 }
                 _ => weight(id),
             }

@@ -73,6 +73,7 @@ mod compact;
 #[cfg(test)]
 mod compact_tests;
 mod cone;
+mod descent_step;
 mod lane_slots;
 mod lanes;
 mod oct;
@@ -90,9 +91,10 @@ mod tests;
 
 pub use codes::{MIN_DIST_SQ, MIN_EMIT_COS};
 pub use cone::Cone;
+pub use descent_step::{DescentRandom, Fresh, Rescaled};
 pub use oct_descent::{DescentSimd, LaneCache};
 pub use quad_descent::{NO_NODE, QuadView, QuadWeights};
-pub use query::{Cut, DescentRandom, Fresh, Rescaled, SplitCriterion, SplitParams};
+pub use query::{Cut, SplitCriterion, SplitParams};
 pub use sg::{
     SgEmitter, SgNode, SgNodes, sg_integral, sharpness_from_mean_length, vmf_normalization,
 };

@@ -21,9 +21,9 @@
 //! [`Rescaled`]: crate::Rescaled
 
 use crate::codes::{LEAF_BIT, receiver_pair, slots_evaluated_for, slots_importance};
+use crate::descent_step::{DescentRandom, choose, chosen, sanitize};
 use crate::lanes::{Fast8, Lanes};
 use crate::oct::TwoOcts;
-use crate::query::{DescentRandom, choose, chosen, sanitize};
 use crate::{LightTree, NodeId};
 use glam::Vec3;
 use std::marker::PhantomData;

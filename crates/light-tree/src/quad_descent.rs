@@ -10,7 +10,7 @@
 //! step between its two children first.
 
 use crate::codes::LEAF_BIT;
-use crate::query::{DescentRandom, choose, chosen, sanitize};
+use crate::descent_step::{DescentRandom, choose, chosen, sanitize};
 use crate::{LightTree, NodeId};
 
 /// A lane that holds no node (the second lane of a leaf's half, the pair step's lanes 2, 3).

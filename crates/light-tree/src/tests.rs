@@ -123,7 +123,7 @@ pub(crate) fn eight_wide_importance(
     let node = tree.node(id);
     match node.children(id) {
         Some((l, r)) if node.depth() % 3 != 0 && node.depth() > first_oct => {
-            let w = |c| crate::query::sanitize(eight_wide_importance(tree, start, c, x, n));
+            let w = |c| crate::descent_step::sanitize(eight_wide_importance(tree, start, c, x, n));
             w(l) + w(r)
         }
         _ => tree.importance(id, x, n),
