@@ -1,17 +1,19 @@
 //! `manylights render`.
 mod knob_args;
+mod report;
 
 use anyhow::{Context, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 pub use knob_args::KnobArgs;
 use render_core::emission_rays::EmissionRays;
+use render_core::estimator::DirectLighting;
 use render_core::filter::PixelFilter;
-use render_core::output::{write_exr, write_json, write_mask_png, write_png};
-use render_core::render::{BudgetClock, RenderSettings, TimeBudget, render};
+use render_core::output::write_json;
+use render_core::render::{BudgetClock, RenderResult, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
+use render_core::scene::Scene;
 use render_core::splat::Reconstruction;
-use render_core::stats::StrategyCounter;
 use samplers::StrategyOptions;
 use std::path::{Path, PathBuf};
 
@@ -200,14 +202,6 @@ fn sampler_parser() -> impl clap::builder::TypedValueParser<Value = Sampler> {
         .map(|s| Sampler::from_name(&s).expect("a listed name"))
 }
 
-fn sibling(out: &Path, suffix: &str) -> PathBuf {
-    let stem = out
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "render".into());
-    out.with_file_name(format!("{stem}{suffix}"))
-}
-
 /// Fails early, before a long render, when the output cannot be written.
 fn check_writable(path: &Path) -> anyhow::Result<()> {
     let dir = match path.parent() {
@@ -224,7 +218,15 @@ fn check_writable(path: &Path) -> anyhow::Result<()> {
     Ok(())
 }
 
-pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+/// What chose the sampler, the filter and the reconstruction of a render.
+struct Choices {
+    sampler: (Sampler, &'static str),
+    filter: (PixelFilter, &'static str),
+    reconstruction: (Reconstruction, &'static str),
+}
+
+/// The flags' own checks, before anything is loaded.
+fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
     if args.spp == Some(0) {
         bail!("--spp must be at least 1");
     }
@@ -243,62 +245,43 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if let Some(p) = &args.png {
         check_writable(p)?;
     }
-    let scene = scene_formats::load_scene(&args.scene, args.camera.as_deref())?;
-    if !args.quiet {
-        for w in &scene.stats.warnings {
-            eprintln!("warning: {w}");
-        }
-    }
-    let opts = args.strategy.options()?;
-    let emission_rays = args.strategy.emission_rays()?;
-    let resolved = args.strategy.resolved()?;
-    let (sampler, sampler_from) = choose_sampler(args.strategy.sampler, &scene, opts.reproduce);
-    let (filter, filter_from) = match (&args.filter, &scene.render_hints.filter) {
+    Ok(())
+}
+
+/// The sampler, filter and reconstruction: each flag, else the scene file's, else the default.
+fn choose(args: &RenderArgs, scene: &Scene, reproduce: bool) -> Choices {
+    let filter = match (&args.filter, &scene.render_hints.filter) {
         (Some(f), _) => (f.clone(), "--filter"),
         (None, Some(f)) => (f.clone(), "scene file"),
         (None, None) => (PixelFilter::default(), "default"),
     };
-    let (reconstruction, reconstruction_from) =
-        choose_reconstruction(args.reconstruction, opts.reproduce);
-    let strategy = samplers::create(&args.strategy.strategy, &scene, &opts)?;
-    if scene.lights.is_empty() && scene.distant_lights.is_empty() {
-        eprintln!("warning: the scene has no lights; the image will be black");
+    Choices {
+        sampler: choose_sampler(args.strategy.sampler, scene, reproduce),
+        filter,
+        reconstruction: choose_reconstruction(args.reconstruction, reproduce),
     }
+}
+
+/// The render's settings from the flags, the scene's camera and the choices; refuses a size
+/// whose buffers would not fit in memory and emission rays under splatting.
+fn settings(
+    args: &RenderArgs,
+    scene: &Scene,
+    choices: &Choices,
+    emission_rays: u32,
+    aux_channels: usize,
+) -> anyhow::Result<RenderSettings> {
     let mut camera = scene.camera(None)?;
     let width = args.width.unwrap_or(camera.width);
     let height = args.height.unwrap_or(camera.height);
     if width == 0 || height == 0 {
         bail!("--width and --height must be positive");
     }
-    render_core::render::check_memory(width, height, strategy.aux_channels().len())
-        .map_err(anyhow::Error::msg)?;
+    render_core::render::check_memory(width, height, aux_channels).map_err(anyhow::Error::msg)?;
     camera.width = width;
     camera.height = height;
-    let spp = match (args.spp, args.time_budget) {
-        (Some(n), _) => Some(n),
-        (None, Some(_)) => None,
-        (None, None) => Some(16),
-    };
-    let settings = RenderSettings {
-        width,
-        height,
-        spp,
-        seed: args.seed,
-        time_budget: args.time_budget.map(|seconds| TimeBudget {
-            seconds,
-            clock: match args.budget_clock {
-                BudgetClockArg::Wall => BudgetClock::Wall,
-                BudgetClockArg::Cpu => BudgetClock::Cpu,
-            },
-        }),
-        threads: args.threads,
-        camera: camera.clone(),
-        sampler,
-        filter: filter.clone(),
-        reconstruction,
-        emission_rays: EmissionRays::new(emission_rays).map_err(anyhow::Error::msg)?,
-    };
-    if settings.emission_rays != EmissionRays::OFF && reconstruction == Reconstruction::Splat {
+    let (reconstruction, reconstruction_from) = choices.reconstruction;
+    if emission_rays != EmissionRays::OFF.get() && reconstruction == Reconstruction::Splat {
         bail!(
             "--emission-rays {} ({}) needs the sampled reconstruction, but {reconstruction_from} \
              chose splatting: add --reconstruction sampled, or --emission-rays 1",
@@ -310,9 +293,41 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             }
         );
     }
+    Ok(RenderSettings {
+        width,
+        height,
+        spp: match (args.spp, args.time_budget) {
+            (Some(n), _) => Some(n),
+            (None, Some(_)) => None,
+            (None, None) => Some(16),
+        },
+        seed: args.seed,
+        time_budget: args.time_budget.map(|seconds| TimeBudget {
+            seconds,
+            clock: match args.budget_clock {
+                BudgetClockArg::Wall => BudgetClock::Wall,
+                BudgetClockArg::Cpu => BudgetClock::Cpu,
+            },
+        }),
+        threads: args.threads,
+        camera,
+        sampler: choices.sampler.0,
+        filter: choices.filter.0.clone(),
+        reconstruction,
+        emission_rays: EmissionRays::new(emission_rays).map_err(anyhow::Error::msg)?,
+    })
+}
+
+/// Renders with a progress bar (in spp, or a spinner under a time budget) unless `--quiet`.
+fn render_with_progress(
+    args: &RenderArgs,
+    scene: &Scene,
+    strategy: &dyn DirectLighting,
+    settings: &RenderSettings,
+) -> anyhow::Result<RenderResult> {
     let bar = if args.quiet {
         ProgressBar::hidden()
-    } else if let Some(n) = spp.filter(|_| args.time_budget.is_none()) {
+    } else if let Some(n) = settings.spp.filter(|_| args.time_budget.is_none()) {
         ProgressBar::new(n as u64)
     } else {
         ProgressBar::new_spinner()
@@ -323,12 +338,11 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         )
         .unwrap_or(ProgressStyle::default_bar()),
     );
-    let result = render(&scene, strategy.as_ref(), &settings, &|_, spp_done| {
+    let result = render(scene, strategy, settings, &|_, spp_done| {
         bar.set_position(spp_done as u64)
     })
     .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
-
     if result.unsampled_pixels() > 0 {
         eprintln!(
             "warning: the time budget ran out inside the first pass: {} of {} pixels have no sample and are black",
@@ -336,143 +350,50 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             result.pixels.len()
         );
     }
-    write_exr(&args.out, width, height, &result.pixels).map_err(anyhow::Error::msg)?;
-    let exposure = args.exposure.unwrap_or_else(|| {
-        render_core::colour::auto_exposure_scale(&result.pixels, &result.unlit_mask()).log2()
-    });
-    if let Some(p) = &args.png {
-        write_png(p, width, height, &result.pixels, exposure).map_err(anyhow::Error::msg)?;
-    }
-    let mut aux_files = Vec::new();
-    if args.aux {
-        let mask = sibling(&args.out, ".mask.png");
-        write_mask_png(&mask, width, height, &result.light_fraction).map_err(anyhow::Error::msg)?;
-        aux_files.push(mask);
-        for (name, values) in &result.aux {
-            let exr = sibling(&args.out, &format!(".{name}.exr"));
-            let px: Vec<glam::Vec3> = values.iter().map(|&v| glam::Vec3::splat(v)).collect();
-            write_exr(&exr, width, height, &px).map_err(anyhow::Error::msg)?;
-            aux_files.push(exr);
-            let colours: Option<Vec<glam::Vec3>> = values
-                .iter()
-                .map(|&v| strategy.aux_colour(name, v))
-                .collect();
-            if let Some(colours) = colours {
-                let png = sibling(&args.out, &format!(".{name}.png"));
-                write_png(&png, width, height, &colours, 0.0).map_err(anyhow::Error::msg)?;
-                aux_files.push(png);
-            }
-        }
-    }
-    let techniques = strategy.techniques();
-    let technique_samples: serde_json::Map<String, serde_json::Value> = techniques
-        .iter()
-        .enumerate()
-        .map(|(i, t)| (t.to_string(), result.counters.technique_samples[i].into()))
-        .collect();
-    let closest = result.counters.camera_rays + result.counters.bsdf_rays;
-    let meta = serde_json::json!({
-        "scene": args.scene,
-        "scene_stats": scene.stats,
-        "scene_hash": scene.content_hash(),
-        "strategy": strategy.name(),
-        "strategy_parameters": strategy.parameters(),
-        "resolved_strategy": resolved,
-        "spp": result.spp,
-        "partial_pass_pixels": result.partial_pixels,
-        "unsampled_pixels": result.unsampled_pixels(),
-        "work_unit_pixels": render_core::render::UNIT_PIXELS,
-        "passes": result.passes,
-        "pilot_camera_samples": result.pilot_samples,
-        "spp_requested": spp,
-        "time_budget_s": args.time_budget,
-        "budget_clock": args.time_budget.map(|_| format!("{:?}", args.budget_clock).to_lowercase()),
-        "seed": args.seed,
-        "sampler": sampler.name(),
-        "sampler_from": sampler_from,
-        "filter": {
-            "name": filter.name(),
-            "parameters": filter.parameters().into_iter().collect::<std::collections::BTreeMap<_, _>>(),
-            "from": filter_from,
-            "reconstruction": reconstruction.name(),
-            "reconstruction_from": reconstruction_from,
-        },
-        "emission_rays": emission_rays,
-        "width": width,
-        "height": height,
-        "camera": camera,
-        "threads": args.threads,
-        "worker_threads": result.threads,
-        "wall_seconds": result.wall_seconds,
-        "cpu_seconds": result.cpu_seconds,
-        "rays": { "camera": result.counters.camera_rays, "emission": result.counters.emission_rays, "shadow": result.counters.shadow_rays, "bsdf": result.counters.bsdf_rays },
-        "shading_points": result.counters.shading_points,
-        "technique_samples": technique_samples,
-        "strategy_counters": result.counters.strategy_means(&strategy.counters()),
-        "unlit_pixel_fraction": result.light_fraction.iter().filter(|&&f| f == 0.0).count() as f64 / result.light_fraction.len() as f64,
-        "aux_files": aux_files,
-        "png_exposure": args.png.as_ref().map(|_| exposure),
-        "png_exposure_auto": args.png.as_ref().map(|_| args.exposure.is_none()),
-        "version": env!("CARGO_PKG_VERSION"),
-        "git_commit": option_env!("MANYLIGHTS_GIT_COMMIT").filter(|s| !s.is_empty()),
-    });
-    write_json(&args.out.with_extension("json"), &meta).map_err(anyhow::Error::msg)?;
-    if args.stats || !args.quiet {
-        let secs = result.wall_seconds.max(1e-9);
-        eprintln!(
-            "{} spp{} in {:.2} s ({} passes); closest-hit rays {:.3} M/s, shadow rays {:.3} M/s (whole render, shading included)",
-            result.spp,
-            if result.partial_pixels > 0 {
-                format!(" + {} pixels of one more", result.partial_pixels)
-            } else {
-                String::new()
-            },
-            secs,
-            result.passes,
-            closest as f64 / secs / 1e6,
-            result.counters.shadow_rays as f64 / secs / 1e6
-        );
-    }
-    if args.stats {
-        print_stats(&result, &strategy.counters());
-    }
-    Ok(())
+    Ok(result)
 }
 
-/// `--stats`: the CPU time and the strategy's own counters, as means per what each is counted per.
-fn print_stats(result: &render_core::render::RenderResult, names: &[StrategyCounter]) {
-    let c = &result.counters;
-    let cpu = result.cpu_seconds.unwrap_or(f64::NAN);
-    eprintln!(
-        "CPU {cpu:.2} s ({:.3} s per spp); {} shading points",
-        cpu / result.spp.max(1) as f64,
-        c.shading_points
-    );
-    let means = c.strategy_means(names);
-    let mut pers: Vec<&str> = Vec::new();
-    for n in names {
-        let per = n.per.unwrap_or("shading point");
-        if !pers.contains(&per) {
-            pers.push(per);
+pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+    check_args(&args)?;
+    let scene = scene_formats::load_scene(&args.scene, args.camera.as_deref())?;
+    if !args.quiet {
+        for w in &scene.stats.warnings {
+            eprintln!("warning: {w}");
         }
     }
-    for per in pers {
-        let line: Vec<String> = names
-            .iter()
-            .filter(|n| n.per.unwrap_or("shading point") == per)
-            .map(|n| {
-                format!(
-                    "{} {:.2}",
-                    n.name,
-                    means[n.name]["mean"].as_f64().unwrap_or(0.0)
-                )
-            })
-            .collect();
-        let header = if per == "shading point" {
-            "per shading point".to_string()
-        } else {
-            format!("per one of the {per}")
-        };
-        eprintln!("{header}: {}", line.join(", "));
+    let opts = args.strategy.options()?;
+    let emission_rays = args.strategy.emission_rays()?;
+    let resolved = args.strategy.resolved()?;
+    let choices = choose(&args, &scene, opts.reproduce);
+    let strategy = samplers::create(&args.strategy.strategy, &scene, &opts)?;
+    if scene.lights.is_empty() && scene.distant_lights.is_empty() {
+        eprintln!("warning: the scene has no lights; the image will be black");
     }
+    let settings = settings(
+        &args,
+        &scene,
+        &choices,
+        emission_rays,
+        strategy.aux_channels().len(),
+    )?;
+    let result = render_with_progress(&args, &scene, strategy.as_ref(), &settings)?;
+    let written = report::write_images(&args, strategy.as_ref(), &settings, &result)?;
+    let meta = report::metadata(
+        &args,
+        &scene,
+        strategy.as_ref(),
+        &settings,
+        &choices,
+        &result,
+        resolved,
+        &written,
+    );
+    write_json(&args.out.with_extension("json"), &meta).map_err(anyhow::Error::msg)?;
+    if args.stats || !args.quiet {
+        report::print_summary(&result);
+    }
+    if args.stats {
+        report::print_stats(&result, &strategy.counters());
+    }
+    Ok(())
 }
