@@ -328,3 +328,30 @@ pub const TREE_SPLIT_BSDF: Strategy = Strategy {
         |name, scene, opts| tree_strategy(name, scene, opts, true, true),
     )
 };
+
+impl crate::brdf_oriented::ls_technique::LsTechnique for TreeSelection {
+    fn tree(&self) -> Option<&LightTree> {
+        self.tree.as_ref()
+    }
+
+    fn prepare_ls(&self, scene: &Scene, sp: &ShadingPoint, one_descent: bool) -> TreeState {
+        if one_descent {
+            self.prepare_capped(sp, 1).with_cached_pmf()
+        } else {
+            LightSelection::prepare(self, scene, sp)
+        }
+    }
+
+    fn sample_ls(
+        &self,
+        _: &TreeState,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        light: u32,
+        pmf: f32,
+        rng: &mut SampleStream,
+        ctx: &mut render_core::estimator::SampleContext,
+    ) -> Option<(render_core::light::LightSample, f32, Vec3, f32)> {
+        crate::light_strategy::sample_pick(scene, sp, light, pmf, rng, ctx.counters)
+    }
+}

@@ -18,6 +18,7 @@
 use render_core::estimator::PIXEL_MEMORY;
 
 use super::importance::LobeDensity;
+use super::ls_technique::LsTechnique;
 use super::pixel_memory::{GLOSSY, REST, SAMPLES, SUM, SUM_SQ, UB, UNIT, WITHIN};
 use super::three_techniques::{PointTechniques, TECHNIQUE_BO, TECHNIQUE_BSDF};
 use crate::point_sets::lattice_sum_variance;
@@ -151,8 +152,8 @@ pub struct Counts {
 
 /// Step 5, learning N_max: the sample's luminance, the rest of its cost and, at a glossy
 /// point, the variance its BRDF-aware samples added, into the pixel's efficiency tally.
-pub fn record_efficiency<L: LobeIntegral + LobeDensity>(
-    point: &PointTechniques<L>,
+pub fn record_efficiency<L: LobeIntegral + LobeDensity, S: LsTechnique>(
+    point: &PointTechniques<L, S>,
     counts: &Counts,
     l: Vec3,
     moments: &[[f32; 2]; 3],

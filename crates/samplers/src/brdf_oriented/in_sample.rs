@@ -5,6 +5,7 @@
 
 use super::allocation::Counts;
 use super::importance::LobeDensity;
+use super::ls_technique::LsTechnique;
 use super::three_techniques::{PointTechniques, Taken};
 use brdf_integrals::LobeIntegral;
 use render_core::estimator::SampleContext;
@@ -47,8 +48,8 @@ impl InSampleCounters {
 /// The authors' in-sample loop (`reproduce`; biased: the outcomes pick the counts): after the
 /// forced BO and BRDF samples, each of the `n` more is BO with the current P(BO) (1/2 without
 /// `adaptive_split`), their one random number rescaled at every step.
-pub fn in_sample_allocation<L: LobeIntegral + LobeDensity>(
-    point: &PointTechniques<L>,
+pub fn in_sample_allocation<L: LobeIntegral + LobeDensity, S: LsTechnique>(
+    point: &PointTechniques<L, S>,
     n: u32,
     lambda: f32,
     adaptive_split: bool,

@@ -5,17 +5,17 @@ use super::allocation::{
 };
 use super::importance::{BoRecord, LobeDensity};
 use super::in_sample::in_sample_allocation;
+use super::ls_technique::LsTechnique;
 use super::pivot_sphere::PivotSphere;
 use super::pixel_memory::{HITS, MISSES};
 use super::sg_importance::SgImportance;
 use super::technique::BoState;
-use super::three_techniques::{LsState, PointTechniques, Taken};
+use super::three_techniques::{PointTechniques, Taken};
 pub use super::three_techniques::{TECHNIQUE_BO, TECHNIQUE_BSDF, TECHNIQUE_LS};
 use super::{BoConfig, LobePivot};
 use crate::mis::power_heuristic;
 use crate::point_sets::{lattice_1d, r3_point};
 use crate::scratch::Pooled;
-use crate::selection::LightSelection;
 use crate::tree_selection::TreeSelection;
 use brdf_integrals::{CapIntegral, LobeIntegral};
 use light_tree::LightTree;
@@ -45,13 +45,14 @@ pub enum Mis3Mode {
 }
 
 /// The strategies `brdf-oriented`, `mis3-equal` and `mis3-adaptive` (Liu, Xu & Yan 2019).
-pub struct Mis3<C: CapIntegral> {
+pub struct Mis3<C: CapIntegral, S: LsTechnique = TreeSelection> {
     /// The strategy's registered name.
     pub name: String,
     /// BO alone, equal counts, or the adaptive allocation.
     pub mode: Mis3Mode,
-    /// The light tree and the LS technique (E&K cut or one descent).
-    pub ls: TreeSelection,
+    /// The LS technique and the light tree both cuts are of: the tree's E&K cut or one
+    /// descent, or (`mis3-adaptive-learned`) the learned cluster selection.
+    pub ls: S,
     /// The cap-integral method behind BO.
     pub integral: C,
     /// The method's knobs.
@@ -63,9 +64,6 @@ pub struct Mis3<C: CapIntegral> {
     pub n_max_now: AtomicU32,
     /// The N_max of each pass (`efficient_total`), for the render's JSON.
     pub n_max_log: Mutex<NMaxLog>,
-    /// `mis3-adaptive-learned`: the learned cluster selection as the LS technique at every
-    /// point (issue 25), in place of the tree's cut or descent.
-    pub learned: Option<crate::learned::selection::LearnedSelection>,
 }
 
 /// Passes completed and the N_max in force from each change on: `(first pass, N_max)`, the
@@ -90,12 +88,12 @@ crate::scratch_pool!(Mis3Scratch, |s| {
     s.bo_terms.clear();
 });
 
-impl<C: CapIntegral> Mis3<C>
+impl<C: CapIntegral, S: LsTechnique> Mis3<C, S>
 where
     C::Lobe: LobePivot + LobeDensity,
 {
     fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<'_, C::Lobe>> {
-        let tree = self.ls.tree.as_ref()?;
+        let tree = self.ls.tree()?;
         let wo_local = sp.bsdf.frame.to_local(sp.wo);
         let lobe = self.integral.lobe(wo_local, sp.bsdf.params.alpha);
         let pivot = if self.config.pivot_sphere {
@@ -119,15 +117,9 @@ where
     }
 }
 
-impl<C: CapIntegral> Mis3<C> {
+impl<C: CapIntegral, S: LsTechnique> Mis3<C, S> {
     /// The strategy `name` in `mode` over the light tree of `ls`.
-    pub fn new(
-        name: String,
-        mode: Mis3Mode,
-        ls: TreeSelection,
-        integral: C,
-        config: BoConfig,
-    ) -> Self {
+    pub fn new(name: String, mode: Mis3Mode, ls: S, integral: C, config: BoConfig) -> Self {
         let n_max_now = AtomicU32::new((config.n_max as f32).to_bits());
         Mis3 {
             name,
@@ -138,7 +130,6 @@ impl<C: CapIntegral> Mis3<C> {
             sg_nodes: None,
             n_max_now,
             n_max_log: Mutex::new(NMaxLog::default()),
-            learned: None,
         }
     }
 
@@ -183,7 +174,7 @@ impl<C: CapIntegral> Mis3<C> {
     }
 }
 
-impl<C: CapIntegral> DirectLighting for Mis3<C>
+impl<C: CapIntegral, S: LsTechnique> DirectLighting for Mis3<C, S>
 where
     C::Lobe: LobePivot + LobeDensity,
 {
@@ -199,21 +190,10 @@ where
             let log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
             map.insert("n_max_by_pass".into(), serde_json::json!(log.changes));
         }
-        if let Some(l) = &self.learned
+        if let Some(d) = self.ls.describe()
             && let Some(map) = v.as_object_mut()
         {
-            let t = l.table.read().unwrap_or_else(|e| e.into_inner());
-            map.insert(
-                "learned".into(),
-                serde_json::json!({
-                    "config": l.config,
-                    "clusters": l.cut.len(),
-                    "cell_size": l.grid.cell,
-                    "regions": t.len(),
-                    "region_memory_bytes": t.memory_bytes(),
-                    "dropped_observations": t.dropped,
-                }),
-            );
+            map.insert("learned".into(), d);
         }
         v
     }
@@ -263,10 +243,7 @@ where
     }
 
     fn begin_render(&self) {
-        if let Some(l) = &self.learned {
-            use crate::learned::Learner;
-            l.forget();
-        }
+        self.ls.begin_render();
         self.n_max_now
             .store((self.config.n_max as f32).to_bits(), Ordering::Relaxed);
         let mut log = self.n_max_log.lock().unwrap_or_else(|e| e.into_inner());
@@ -301,16 +278,9 @@ where
     }
 
     fn end_pass(&self, pixel_memory: &mut dyn Iterator<Item = &[f32; PIXEL_MEMORY]>) {
-        let Some(learned) = &self.learned else {
-            return self.learn_n_max(pixel_memory);
-        };
         // Both learners read every pixel, in pixel order.
         let pixels: Vec<&[f32; PIXEL_MEMORY]> = pixel_memory.collect();
-        learned
-            .table
-            .write()
-            .unwrap_or_else(|e| e.into_inner())
-            .merge_pass(&mut pixels.iter().copied(), super::pixel_memory::LEARNED);
+        self.ls.end_pass(&pixels);
         self.learn_n_max(&mut pixels.iter().copied());
     }
 
@@ -321,7 +291,7 @@ where
         rng: &mut SampleStream,
         ctx: &mut SampleContext,
     ) -> Vec3 {
-        let Some(tree) = self.ls.tree.as_ref() else {
+        let Some(tree) = self.ls.tree() else {
             return Vec3::ZERO;
         };
         if self.mode == Mis3Mode::BoOnly {
@@ -351,7 +321,7 @@ where
     }
 }
 
-impl<C: CapIntegral> Mis3<C>
+impl<C: CapIntegral, S: LsTechnique> Mis3<C, S>
 where
     C::Lobe: LobePivot + LobeDensity,
 {
@@ -396,25 +366,20 @@ where
         scene: &'a Scene,
         sp: &'a ShadingPoint,
         tree: &'a LightTree,
-    ) -> PointTechniques<'a, C::Lobe> {
+    ) -> PointTechniques<'a, C::Lobe, S> {
         let bo = if sp.bsdf.is_pure_diffuse() {
             None
         } else {
             self.bo_state(sp)
         };
-        let ls = if let Some(learned) = &self.learned {
-            let table = learned.table.read().unwrap_or_else(|e| e.into_inner());
-            LsState::Learned(learned, learned.prepare_with(scene, sp, &table))
-        } else if bo.is_some() && self.config.single_ls_at_glossy {
-            LsState::Tree(&self.ls, self.ls.prepare_capped(sp, 1).with_cached_pmf())
-        } else {
-            LsState::Tree(&self.ls, self.ls.prepare(scene, sp))
-        };
+        let one_descent = bo.is_some() && self.config.single_ls_at_glossy;
+        let ls_state = self.ls.prepare_ls(scene, sp, one_descent);
         PointTechniques {
             scene,
             sp,
             tree,
-            ls,
+            ls: &self.ls,
+            ls_state,
             bo,
             fresh: !self.config.reproduce,
         }
@@ -424,7 +389,7 @@ where
     /// point, one of each under `mis3-equal`, otherwise heuristic 1's N split by heuristic 2.
     fn brdf_aware_samples(
         &self,
-        point: &PointTechniques<C::Lobe>,
+        point: &PointTechniques<C::Lobe, S>,
         taken: &mut Vec<Taken>,
         rng: &mut SampleStream,
         ctx: &mut SampleContext,
@@ -486,7 +451,7 @@ where
     /// BRDF samples' hits and misses go to the pixel's tallies for its next samples.
     fn fixed_allocation(
         &self,
-        point: &PointTechniques<C::Lobe>,
+        point: &PointTechniques<C::Lobe, S>,
         n: u32,
         taken: &mut Vec<Taken>,
         rng: &mut SampleStream,
@@ -518,8 +483,8 @@ where
 }
 
 /// The cut sizes and counts for the render's statistics, and the two diagnostic channels.
-fn record_counts<L: LobeIntegral + LobeDensity>(
-    point: &PointTechniques<L>,
+fn record_counts<L: LobeIntegral + LobeDensity, S: LsTechnique>(
+    point: &PointTechniques<L, S>,
     counts: &Counts,
     ctx: &mut SampleContext,
 ) {

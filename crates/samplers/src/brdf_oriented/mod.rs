@@ -15,6 +15,7 @@ pub mod allocation;
 pub mod cut;
 pub mod importance;
 pub mod in_sample;
+pub mod ls_technique;
 pub mod mis3;
 pub mod pivot_sphere;
 pub mod pixel_memory;

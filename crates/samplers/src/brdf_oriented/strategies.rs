@@ -1,6 +1,7 @@
 //! The strategies of Liu, Xu & Yan 2019 as registry values: BRDF-oriented sampling alone, and the
 //! three-technique MIS with equal or adaptive counts (with the E&K cut or the learned cluster
 //! selection as its LS technique).
+use super::ls_technique::LsTechnique;
 use super::mis3::{Mis3, Mis3Mode};
 use super::{BoImportance, BrdfIntegral};
 use crate::strategy::Strategy;
@@ -61,33 +62,39 @@ fn resolve_learned_method(_: &str, opts: &StrategyOptions) -> Value {
     })
 }
 
-/// The method's estimator in the mode the name asks for.
+/// The method's estimator in the mode the name asks for, with the tree's E&K cut (or one
+/// descent) as its LS technique, or the learned cluster selection for `mis3-adaptive-learned`.
 fn build(
     name: &str,
     scene: &Scene,
     opts: &StrategyOptions,
+) -> Result<Box<dyn DirectLighting>, StrategyError> {
+    if name == MIS3_ADAPTIVE_LEARNED.name {
+        let ls = learned::selection::LearnedSelection::new(scene, opts.power_units(), opts.learned)
+            .map_err(StrategyError::BadOption)?;
+        with_ls(name, scene, opts, ls)
+    } else {
+        let split = TreeMode::Split(opts.split_params());
+        let ls = TreeSelection::new(scene, split, opts.power_units())
+            .map_err(StrategyError::BadOption)?;
+        with_ls(name, scene, opts, ls)
+    }
+}
+
+/// [`build`] once its LS technique is made.
+fn with_ls<S: LsTechnique + 'static>(
+    name: &str,
+    scene: &Scene,
+    opts: &StrategyOptions,
+    ls: S,
 ) -> Result<Box<dyn DirectLighting>, StrategyError> {
     let mode = match name {
         "brdf-oriented" => Mis3Mode::BoOnly,
         "mis3-equal" => Mis3Mode::Equal,
         _ => Mis3Mode::Adaptive,
     };
-    let ls = TreeSelection::new(
-        scene,
-        TreeMode::Split(opts.split_params()),
-        opts.power_units(),
-    )
-    .map_err(StrategyError::BadOption)?;
     let config = resolve::bo_config(opts);
-    let learned = if name == MIS3_ADAPTIVE_LEARNED.name {
-        Some(
-            learned::selection::LearnedSelection::new(scene, opts.power_units(), opts.learned)
-                .map_err(StrategyError::BadOption)?,
-        )
-    } else {
-        None
-    };
-    let sg_nodes = match (opts.bo_importance, &ls.tree) {
+    let sg_nodes = match (opts.bo_importance, ls.tree()) {
         (BoImportance::Sg, Some(tree)) => Some(
             light_tree::SgNodes::build(tree, &crate::sg::sg_emitters(scene))
                 .map_err(|e| StrategyError::BadOption(format!("SG lights: {e}")))?,
@@ -97,7 +104,6 @@ fn build(
     Ok(match opts.brdf_integral {
         BrdfIntegral::Sptd => Box::new(Mis3 {
             sg_nodes,
-            learned,
             ..Mis3::new(name.into(), mode, ls, resolve::sptd(opts), config)
         }),
         BrdfIntegral::Ltc => {
@@ -112,7 +118,6 @@ fn build(
             }
             Box::new(Mis3 {
                 sg_nodes,
-                learned,
                 ..Mis3::new(name.into(), mode, ls, integral, config)
             })
         }

@@ -2,12 +2,9 @@
 //! light sampling (BO) and BRDF sampling. Each sample drawn is kept with the densities of all
 //! three techniques at its light point, so that the strategy can weight it by MIS.
 use super::importance::LobeDensity;
+use super::ls_technique::LsTechnique;
 use super::technique::BoState;
 use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
-use crate::learned::selection::{LearnedSelection, LearnedState, sample_observed};
-use crate::light_strategy::sample_pick;
-use crate::selection::LightSelection;
-use crate::tree_selection::{TreeSelection, TreeState};
 use brdf_integrals::LobeIntegral;
 use light_tree::LightTree;
 use render_core::estimator::{SampleContext, ShadingPoint};
@@ -38,22 +35,24 @@ pub struct Taken {
 
 /// One shading point with both cuts made: the LS state (E&K cut or one descent) and, at a
 /// glossy point, the BO state (BO cut and its record).
-pub struct PointTechniques<'a, L> {
+pub struct PointTechniques<'a, L, S: LsTechnique> {
     /// The scene (lights and occlusion).
     pub scene: &'a Scene,
     /// The shading point.
     pub sp: &'a ShadingPoint,
     /// The light tree both cuts are of.
     pub tree: &'a LightTree,
-    /// The LS technique and its state at this point.
-    pub ls: LsState<'a>,
+    /// The LS technique.
+    pub ls: &'a S,
+    /// Its state at this point.
+    pub ls_state: S::State,
     /// The BO state, at glossy points.
     pub bo: Option<BoState<'a, L>>,
     /// BO's descent takes a fresh random number per tree level (off: the authors' rescaled one).
     pub fresh: bool,
 }
 
-impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
+impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
     /// Densities of the three techniques at a light point (solid angle; delta lights use the
     /// discrete selection probabilities and no BRDF density). `own` is the sampling technique,
     /// whose density the caller already has (left at 0, or computed for a debug check).
@@ -77,7 +76,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
             } else {
                 l.pdf(sp.point(), point, normal)
             };
-            self.ls.pmf(sp, light as u32) * p_pt
+            self.ls.pmf(&self.ls_state, sp, light as u32) * p_pt
         };
         let p_bo = match &self.bo {
             Some(b) if own != TECHNIQUE_BO || cfg!(debug_assertions) => {
@@ -102,19 +101,13 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
         ctx: &mut SampleContext,
     ) {
         let (scene, sp) = (self.scene, self.sp);
-        self.ls.pick(sp, rng, picks);
+        self.ls.pick(&self.ls_state, sp, rng, picks);
         for &(light, pmf) in picks.iter() {
             ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
-            let sampled = match &self.ls {
-                LsState::Learned(sel, st) => {
-                    let u = rng.next_2d();
-                    let memory = &mut ctx.pixel_memory[super::pixel_memory::LEARNED..];
-                    sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, *sel, st)
-                        .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf)))
-                }
-                LsState::Tree(..) => sample_pick(scene, sp, light, pmf, rng, ctx.counters)
-                    .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf))),
-            };
+            let sampled = self
+                .ls
+                .sample_ls(&self.ls_state, scene, sp, light, pmf, rng, ctx)
+                .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf)));
             let Some((s, p_ls, f, p_bsdf)) = sampled else {
                 continue;
             };
@@ -129,7 +122,7 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
             );
             debug_assert!(
                 {
-                    let replay = self.ls.pmf(sp, light)
+                    let replay = self.ls.pmf(&self.ls_state, sp, light)
                         * scene.lights[light as usize].pdf(sp.point(), s.point, s.normal);
                     s.is_delta || (replay - p_ls).abs() <= 1e-3 * p_ls
                 },
@@ -242,41 +235,8 @@ impl<L: LobeIntegral + LobeDensity> PointTechniques<'_, L> {
     /// Clusters of the LS cut and of the BO cut (0 without BO).
     pub fn cluster_counts(&self) -> (usize, usize) {
         (
-            self.ls.clusters(),
+            self.ls.clusters(&self.ls_state),
             self.bo.as_ref().map_or(0, |b| b.cut().cut.len()),
         )
-    }
-}
-
-/// The LS technique of one point: the light tree (E&K cut or one descent) or, in
-/// `mis3-adaptive-learned`, the learned cluster selection (issue 25).
-pub enum LsState<'a> {
-    /// The tree and its cut at this point.
-    Tree(&'a TreeSelection, TreeState),
-    /// The learned selection and its cluster probabilities at this point.
-    Learned(&'a LearnedSelection, LearnedState),
-}
-
-impl LsState<'_> {
-    fn pick(&self, sp: &ShadingPoint, rng: &mut SampleStream, picks: &mut Vec<(u32, f32)>) {
-        match self {
-            LsState::Tree(s, st) => s.pick(st, sp, rng, picks),
-            LsState::Learned(s, st) => s.pick(st, sp, rng, picks),
-        }
-    }
-
-    /// The LS probability of choosing `light`.
-    pub fn pmf(&self, sp: &ShadingPoint, light: u32) -> f32 {
-        match self {
-            LsState::Tree(s, st) => s.pmf(st, sp, light),
-            LsState::Learned(s, st) => s.pmf(st, sp, light),
-        }
-    }
-
-    fn clusters(&self) -> usize {
-        match self {
-            LsState::Tree(s, st) => s.clusters(st),
-            LsState::Learned(s, st) => s.clusters(st),
-        }
     }
 }

@@ -377,3 +377,58 @@ impl Learner for LearnedSelection {
         })
     }
 }
+
+/// `mis3-adaptive-learned`: the learned selection as the method's LS technique at every point,
+/// its observation in the method's pixel memory from
+/// [`crate::brdf_oriented::pixel_memory::LEARNED`] on.
+impl crate::brdf_oriented::ls_technique::LsTechnique for LearnedSelection {
+    fn tree(&self) -> Option<&LightTree> {
+        self.tree.tree.as_ref()
+    }
+
+    fn prepare_ls(&self, scene: &Scene, sp: &ShadingPoint, _: bool) -> LearnedState {
+        let table = self.table.read().unwrap_or_else(|e| e.into_inner());
+        self.prepare_with(scene, sp, &table)
+    }
+
+    fn sample_ls(
+        &self,
+        state: &LearnedState,
+        scene: &Scene,
+        sp: &ShadingPoint,
+        light: u32,
+        pmf: f32,
+        rng: &mut render_core::rng::SampleStream,
+        ctx: &mut render_core::estimator::SampleContext,
+    ) -> Option<(render_core::light::LightSample, f32, render_core::Vec3, f32)> {
+        let u = rng.next_2d();
+        let memory = &mut ctx.pixel_memory[crate::brdf_oriented::pixel_memory::LEARNED..];
+        sample_observed(scene, sp, light, pmf, u, ctx.counters, memory, self, state)
+    }
+
+    fn begin_render(&self) {
+        Learner::forget(self);
+    }
+
+    fn end_pass(&self, pixels: &[&[f32; render_core::estimator::PIXEL_MEMORY]]) {
+        self.table
+            .write()
+            .unwrap_or_else(|e| e.into_inner())
+            .merge_pass(
+                &mut pixels.iter().copied(),
+                crate::brdf_oriented::pixel_memory::LEARNED,
+            );
+    }
+
+    fn describe(&self) -> Option<serde_json::Value> {
+        let t = self.table.read().unwrap_or_else(|e| e.into_inner());
+        Some(serde_json::json!({
+            "config": self.config,
+            "clusters": self.cut.len(),
+            "cell_size": self.grid.cell,
+            "regions": t.len(),
+            "region_memory_bytes": t.memory_bytes(),
+            "dropped_observations": t.dropped,
+        }))
+    }
+}
