@@ -101,8 +101,8 @@ pub struct StrategyArgs {
     /// straddle a light's edge (every pixel in the first pass, then those near a light not yet
     /// seen to be fully inside one): 1 traces only the sample's own ray; more lowers the noise of
     /// a pixel's coverage of the lights, which light sampling never touches. Needs the sampled
-    /// reconstruction. [default: the strategy's (`manylights strategies --json`): 16 for
-    /// mis3-adaptive and mis3-adaptive-learned, 1 for the others and under --reproduce]
+    /// reconstruction. [default: the strategy's own, which `manylights strategies --json` lists;
+    /// 1 under --reproduce]
     #[arg(long, value_parser = emission_rays_parser)]
     pub emission_rays: Option<u32>,
     #[command(flatten)]
