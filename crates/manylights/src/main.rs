@@ -128,8 +128,8 @@ fn list_strategies(json: bool) -> anyhow::Result<()> {
     let list: Vec<serde_json::Value> = samplers::strategies()
         .iter()
         .map(|s| {
-            let knobs: Vec<serde_json::Value> = std::iter::once(samplers::knobs::REPRODUCE)
-                .chain(s.knobs.iter().copied())
+            let knobs: Vec<serde_json::Value> = s
+                .all_knobs()
                 .filter_map(samplers::knobs::knob)
                 .map(|k| serde_json::json!({ "flag": format!("--{}", k.flag), "default": k.default_value(), "help": k.help }))
                 .collect();

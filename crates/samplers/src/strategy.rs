@@ -66,15 +66,19 @@ impl Strategy {
         self.name == name || self.other_names.is_some_and(|f| f(name))
     }
 
+    /// Every knob it takes (without `--`): [`REPRODUCE`], then its own.
+    pub fn all_knobs(&self) -> impl Iterator<Item = &'static str> + '_ {
+        std::iter::once(REPRODUCE).chain(self.knobs.iter().copied())
+    }
+
     /// Whether it reads the knob `flag` (without `--`).
     pub fn takes(&self, flag: &str) -> bool {
-        flag == REPRODUCE || self.knobs.contains(&flag)
+        self.all_knobs().any(|k| k == flag)
     }
 
     /// The flags it takes, as `--help` spells them, comma-separated.
     pub fn flags(&self) -> String {
-        std::iter::once(REPRODUCE)
-            .chain(self.knobs.iter().copied())
+        self.all_knobs()
             .map(|f| format!("--{f}"))
             .collect::<Vec<_>>()
             .join(", ")

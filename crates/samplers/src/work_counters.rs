@@ -10,6 +10,8 @@ const BO_CLUSTERS: usize = 3;
 const BRDF_AWARE: usize = 4;
 const BRDF_AWARE_GLOSSY: usize = 5;
 
+const _: () = assert!(BRDF_AWARE_GLOSSY < render_core::stats::MAX_STRATEGY_COUNTERS);
+
 /// The name of the glossy-point counter, which the per-glossy-point means are per.
 pub const GLOSSY: &str = "glossy points";
 
