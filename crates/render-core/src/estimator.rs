@@ -118,6 +118,13 @@ pub trait DirectLighting: Send + Sync {
         rng: &mut SampleStream,
         ctx: &mut SampleContext,
     ) -> Vec3;
+    /// The strategy's whole-image form, if it has one: the render loop then runs each pass
+    /// through it (`crate::image_space`) instead of calling [`DirectLighting::estimate`] per
+    /// camera sample. `estimate` must still be an unbiased estimator of its own (tools and
+    /// tests shade single points with it).
+    fn image_space(&self) -> Option<&dyn crate::image_space::ImageSpaceLighting> {
+        None
+    }
     /// Called once before a render's first sample: forget what an earlier render taught.
     fn begin_render(&self) {}
     /// The weight of pass `pass` (from 0) in every pixel's average, > 0: a function of the

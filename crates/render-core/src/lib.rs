@@ -18,6 +18,7 @@ pub mod emission_rays;
 pub mod error;
 pub mod estimator;
 pub mod frame;
+pub mod image_space;
 pub mod light;
 pub mod material;
 pub mod metrics;

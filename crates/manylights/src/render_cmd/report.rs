@@ -126,6 +126,7 @@ pub(super) fn metadata(
         "shading_points": result.counters.shading_points,
         "technique_samples": technique_samples,
         "strategy_counters": result.counters.strategy_means(&strategy.counters()),
+        "image_space_bytes_per_pixel": strategy.image_space().map(|s| s.bytes_per_pixel()),
         "unlit_pixel_fraction": result.light_fraction.iter().filter(|&&f| f == 0.0).count() as f64 / result.light_fraction.len() as f64,
         "aux_files": written.aux_files,
         "png_exposure": args.png.as_ref().map(|_| written.exposure),

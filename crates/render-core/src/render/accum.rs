@@ -1,5 +1,7 @@
 //! What a render keeps per pixel while it runs, and whether the machine can hold it.
-use crate::estimator::{MAX_AUX, PIXEL_MEMORY};
+use super::unit::PixelSample;
+use crate::estimator::{MAX_AUX, PIXEL_MEMORY, ShadingPoint};
+use crate::rng::SampleStream;
 use glam::Vec3;
 
 /// A pixel's running sums over its samples so far.
@@ -26,10 +28,31 @@ pub fn memory_estimate(width: u32, height: u32, aux_channels: usize) -> u64 {
     width as u64 * height as u64 * per_pixel as u64
 }
 
+/// Bytes per pixel an image-space pass adds (`crate::image_space`): the shading points, sample
+/// streams and camera samples of the pass, its result, and `strategy_bytes` of the strategy's own.
+pub(super) fn image_pass_bytes(strategy_bytes: usize) -> usize {
+    size_of::<Option<ShadingPoint>>()
+        + size_of::<SampleStream>()
+        + size_of::<PixelSample>()
+        + size_of::<(Vec3, [f32; MAX_AUX])>()
+        + strategy_bytes
+}
+
 /// Refuses, before anything is allocated, a render that needs more memory than the machine
 /// has (where the platform says how much it has).
 pub fn check_memory(width: u32, height: u32, aux_channels: usize) -> Result<(), String> {
-    let need = memory_estimate(width, height, aux_channels);
+    check_memory_with(width, height, aux_channels, 0)
+}
+
+/// [`check_memory`] for a render that holds `extra_per_pixel` bytes more per pixel.
+pub(super) fn check_memory_with(
+    width: u32,
+    height: u32,
+    aux_channels: usize,
+    extra_per_pixel: usize,
+) -> Result<(), String> {
+    let need = memory_estimate(width, height, aux_channels)
+        + width as u64 * height as u64 * extra_per_pixel as u64;
     match host::physical_memory_bytes() {
         Some(have) if need > have => Err(format!(
             "a {width}×{height} render needs about {:.1} GiB ({} bytes per pixel), more than \

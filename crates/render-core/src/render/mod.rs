@@ -15,10 +15,12 @@
 //! pixel's running sums, the memory check), `passes.rs` (the passes and their work units),
 //! `pass_job.rs` (what the units share), `unit.rs` (one unit's samples), `shading.rs` (a camera
 //! ray's shading), `emission.rs` (extra emission rays), `pilot_run.rs` (a strategy's pilot) and
-//! `finish.rs` (the image and its diagnostics).
+//! `image_pass.rs` (a pass of a strategy that works on the whole image, `crate::image_space`)
+//! and `finish.rs` (the image and its diagnostics).
 mod accum;
 mod emission;
 mod finish;
+mod image_pass;
 mod pass_job;
 mod passes;
 mod pilot_run;
@@ -53,10 +55,12 @@ pub fn render(
     progress: &(dyn Fn(u32, u32) + Sync),
 ) -> Result<RenderResult, String> {
     settings.check()?;
-    check_memory(
+    let image_space = strategy.image_space();
+    accum::check_memory_with(
         settings.width,
         settings.height,
         strategy.aux_channels().len(),
+        image_space.map_or(0, |s| accum::image_pass_bytes(s.bytes_per_pixel())),
     )?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads.unwrap_or(0))

@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 pub(super) struct Passes {
     pub(super) accum: Vec<PixelAccum>,
     /// The samples of the pass under way, kept for its gather when splatting.
-    splats: Vec<PassSample>,
+    pub(super) splats: Vec<PassSample>,
     pub(super) film: Option<SplatFilm>,
     /// Full passes done.
     pub(super) spp_done: u32,
@@ -60,6 +60,7 @@ impl Passes {
         progress: &(dyn Fn(u32, u32) + Sync),
     ) -> Result<(), String> {
         let stop = AtomicBool::new(false);
+        let image_space = job.strategy.image_space();
         loop {
             if let Some(limit) = job.settings.spp
                 && self.spp_done >= limit
@@ -69,9 +70,24 @@ impl Passes {
             if stop.load(Ordering::Relaxed) {
                 break;
             }
+            // An image-space pass is never cut short: its budget is checked between passes.
+            if let (Some(_), Some(clock)) = (image_space, clock)
+                && self.passes > 0
+                && clock.spent(&mut None)
+            {
+                break;
+            }
             let pass_weight = job.pass_weight(self.spp_done)?;
             self.weights.push(pass_weight);
-            let (done, n_units) = self.pass(job, pool, (clock, &stop), pass_weight, counters);
+            let (done, n_units) = match image_space {
+                Some(strategy) => {
+                    let sample = (self.spp_done as u64, pass_weight);
+                    self.image_pass(job, pool, strategy, sample, counters)?;
+                    let n_units = job.grid.len().div_ceil(UNIT_PIXELS);
+                    (n_units, n_units)
+                }
+                None => self.pass(job, pool, (clock, &stop), pass_weight, counters),
+            };
             if done == 0 {
                 break;
             }

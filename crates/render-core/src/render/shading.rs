@@ -5,6 +5,7 @@ use crate::camera::Camera;
 use crate::estimator::{DirectLighting, SampleContext, ShadingPoint};
 use crate::rng::SampleStream;
 use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
+use crate::stats::Counters;
 use glam::{Vec2, Vec3};
 
 /// What one camera ray found: the emission it sees, the strategy's direct-lighting estimate and
@@ -27,10 +28,28 @@ pub(super) fn shade_camera_sample(
     rng: &mut SampleStream,
     ctx: &mut SampleContext,
 ) -> CameraSample {
+    let (mut out, sp) = camera_hit(scene, camera, aspect, film, ctx.counters);
+    let Some(sp) = sp else {
+        return out;
+    };
+    out.direct = strategy.estimate(scene, &sp, rng, ctx);
+    out.distant = distant_lighting(scene, &sp, ctx.counters);
+    out
+}
+
+/// What a camera ray through `film` sees before any direct lighting: the emission it sees
+/// (in `CameraSample::emitted`) and the shading point of its hit, if the hit reflects.
+pub(super) fn camera_hit(
+    scene: &Scene,
+    camera: &Camera,
+    aspect: f32,
+    film: Vec2,
+    counters: &mut Counters,
+) -> (CameraSample, Option<ShadingPoint>) {
     let dir = camera.ray_direction(film, aspect);
-    ctx.counters.camera_rays += 1;
+    counters.camera_rays += 1;
     let Some(hit) = scene.intersect(camera.position, dir, 0.0, f32::INFINITY) else {
-        return CameraSample::default();
+        return (CameraSample::default(), None);
     };
     let wo = -dir;
     let mut out = CameraSample::default();
@@ -38,24 +57,22 @@ pub(super) fn shade_camera_sample(
         out.emitted = scene.lights[hit.light as usize].emitted(hit.ng, hit.uv, wo);
         out.sees_light = out.emitted != Vec3::ZERO;
     }
-    let Some(sp) = shading_point(scene, hit, wo) else {
-        return out;
-    };
-    ctx.counters.shading_points += 1;
-    out.direct = strategy.estimate(scene, &sp, rng, ctx);
-    out.distant = distant_lighting(scene, &sp, ctx);
-    out
+    let sp = shading_point(scene, hit, wo);
+    if sp.is_some() {
+        counters.shading_points += 1;
+    }
+    (out, sp)
 }
 
 /// Directional lights, each a delta: one shadow ray apiece.
-fn distant_lighting(scene: &Scene, sp: &ShadingPoint, ctx: &mut SampleContext) -> Vec3 {
+pub(super) fn distant_lighting(scene: &Scene, sp: &ShadingPoint, counters: &mut Counters) -> Vec3 {
     let mut l = Vec3::ZERO;
     for d in &scene.distant_lights {
         let f = sp.bsdf.eval_cos(sp.wo, d.direction) * d.irradiance;
         if f == Vec3::ZERO {
             continue;
         }
-        ctx.counters.shadow_rays += 1;
+        counters.shadow_rays += 1;
         if !scene.accel.occluded(
             sp.origin_towards(d.direction),
             d.direction,

@@ -6,8 +6,36 @@ use crate::estimator::{MAX_AUX, SampleContext};
 use crate::rng::SampleStream;
 use crate::splat::PassSample;
 use crate::stats::Counters;
+use glam::{Vec2, Vec3};
+
+/// One camera sample of a pixel, shaded, before it is added to the pixel's sums.
+pub(super) struct PixelSample {
+    /// Where it fell on the film, in pixels, and the filter weight it carries.
+    pub(super) on_film: Vec2,
+    pub(super) weight: f32,
+    /// Camera rays for its emission (1, or more for a split sample).
+    pub(super) rays: u32,
+    pub(super) camera: CameraSample,
+    /// The extra emission rays' filter-weighted sum and how many saw a light.
+    pub(super) extra: (Vec3, u32),
+    pub(super) aux: [f32; MAX_AUX],
+}
 
 impl PassJob<'_> {
+    /// The random numbers of sample `sample_index` of pixel `index`.
+    pub(super) fn sample_stream(&self, index: usize, sample_index: u64) -> SampleStream {
+        self.in_grid(
+            index,
+            SampleStream::with_sampler(
+                self.settings.sampler,
+                self.settings.seed,
+                index as u64,
+                sample_index,
+            )
+            .with_pixel_samples(self.settings.spp.unwrap_or(0)),
+        )
+    }
+
     /// Sample `sample_index` of the pixels of work unit `u`, accumulated into `unit` and, when
     /// splatting, kept in `splats` for the pass's gather.
     pub(super) fn render_unit(
@@ -19,16 +47,7 @@ impl PassJob<'_> {
     ) {
         for (i, px) in unit.iter_mut().enumerate() {
             let index = u * UNIT_PIXELS + i;
-            let mut rng = self.in_grid(
-                index,
-                SampleStream::with_sampler(
-                    self.settings.sampler,
-                    self.settings.seed,
-                    index as u64,
-                    sample_index,
-                )
-                .with_pixel_samples(self.settings.spp.unwrap_or(0)),
-            );
+            let mut rng = self.sample_stream(index, sample_index);
             let (on_film, film, weight) = self.film_position(index, &mut rng);
             // Fixed before the sample is drawn, from the pixel's earlier passes only.
             let rays = self.settings.emission_rays.rays_for(px.split);
@@ -37,12 +56,7 @@ impl PassJob<'_> {
                 aux: [0.0; MAX_AUX],
                 pixel_memory: &mut px.memory,
             };
-            let CameraSample {
-                emitted,
-                direct,
-                distant,
-                sees_light,
-            } = shade_camera_sample(
+            let camera = shade_camera_sample(
                 self.scene,
                 self.strategy,
                 &self.settings.camera,
@@ -52,32 +66,63 @@ impl PassJob<'_> {
                 &mut ctx,
             );
             let aux = ctx.aux;
-            // Exact for the weight-1 filters (box, triangle).
-            let l = if rays == 1 {
-                ((emitted + direct) + distant) * weight
+            let extra = if rays == 1 {
+                (Vec3::ZERO, 0)
             } else {
-                let (sum, lit) = self.extra_emission(index, sample_index, rays, c);
-                px.extra_rays += rays - 1;
-                px.extra_lit += lit;
-                (direct + distant) * weight + (emitted * weight + sum) / rays as f32
+                self.extra_emission(index, sample_index, rays, c)
             };
-            // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
-            for k in 0..3 {
-                let v = l[k] as f64;
-                px.sum[k] += pass_weight * v;
-                px.sum_sq[k] += pass_weight * (v * v);
-            }
-            px.light_hits += sees_light as u32;
-            for (acc, v) in px.aux.iter_mut().zip(aux).take(self.n_aux) {
-                *acc += v as f64;
-            }
-            if let Some(s) = splats.get_mut(i) {
-                *s = PassSample {
-                    radiance: l,
-                    film: on_film,
-                    sees_light,
-                };
-            }
+            let sample = PixelSample {
+                on_film,
+                weight,
+                rays,
+                camera,
+                extra,
+                aux,
+            };
+            self.accumulate(px, splats.get_mut(i), sample, pass_weight);
+        }
+    }
+
+    /// Adds a shaded camera sample to its pixel's sums (and, when splatting, to the pass's samples).
+    pub(super) fn accumulate(
+        &self,
+        px: &mut PixelAccum,
+        splat: Option<&mut PassSample>,
+        s: PixelSample,
+        pass_weight: f64,
+    ) {
+        let CameraSample {
+            emitted,
+            direct,
+            distant,
+            sees_light,
+        } = s.camera;
+        let weight = s.weight;
+        // Exact for the weight-1 filters (box, triangle).
+        let l = if s.rays == 1 {
+            ((emitted + direct) + distant) * weight
+        } else {
+            let (sum, lit) = s.extra;
+            px.extra_rays += s.rays - 1;
+            px.extra_lit += lit;
+            (direct + distant) * weight + (emitted * weight + sum) / s.rays as f32
+        };
+        // A non-finite sample is a bug upstream; keep it visible in the image rather than hiding it.
+        for k in 0..3 {
+            let v = l[k] as f64;
+            px.sum[k] += pass_weight * v;
+            px.sum_sq[k] += pass_weight * (v * v);
+        }
+        px.light_hits += sees_light as u32;
+        for (acc, v) in px.aux.iter_mut().zip(s.aux).take(self.n_aux) {
+            *acc += v as f64;
+        }
+        if let Some(splat) = splat {
+            *splat = PassSample {
+                radiance: l,
+                film: s.on_film,
+                sees_light,
+            };
         }
     }
 }

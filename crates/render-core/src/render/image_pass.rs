@@ -1,0 +1,96 @@
+//! A pass of a strategy that works on the whole image (`crate::image_space`): every pixel's
+//! camera sample traced to its shading point, the strategy's phases over the image, then each
+//! pixel's sample added to its sums exactly as a per-sample pass adds it.
+use super::pass_job::PassJob;
+use super::passes::Passes;
+use super::shading::{camera_hit, distant_lighting};
+use super::unit::PixelSample;
+use crate::estimator::MAX_AUX;
+use crate::image_space::{ImagePass, ImageSpaceLighting, par_pixels};
+use crate::stats::Counters;
+use glam::Vec3;
+use std::sync::Mutex;
+
+impl Passes {
+    /// Pass `sample_index` of every pixel through `strategy`'s image-space form.
+    pub(super) fn image_pass(
+        &mut self,
+        job: &PassJob,
+        pool: &rayon::ThreadPool,
+        strategy: &dyn ImageSpaceLighting,
+        (sample_index, pass_weight): (u64, f64),
+        counters: &mut Counters,
+    ) -> Result<(), String> {
+        let n = job.grid.len();
+        let accum = &self.accum;
+        let (traced, c) = par_pixels(pool, n, |i, c| {
+            let mut rng = job.sample_stream(i, sample_index);
+            let (on_film, film, weight) = job.film_position(i, &mut rng);
+            let rays = job.settings.emission_rays.rays_for(accum[i].split);
+            let (mut camera, sp) = camera_hit(job.scene, &job.settings.camera, job.aspect, film, c);
+            if let Some(sp) = &sp {
+                camera.distant = distant_lighting(job.scene, sp, c);
+            }
+            let extra = if rays == 1 {
+                (Vec3::ZERO, 0)
+            } else {
+                job.extra_emission(i, sample_index, rays, c)
+            };
+            let sample = PixelSample {
+                on_film,
+                weight,
+                rays,
+                camera,
+                extra,
+                aux: [0.0; MAX_AUX],
+            };
+            (sample, sp, rng)
+        });
+        counters.merge(&c);
+        let mut samples = Vec::with_capacity(n);
+        let mut points = Vec::with_capacity(n);
+        let mut streams = Vec::with_capacity(n);
+        for (s, p, r) in traced {
+            samples.push(s);
+            points.push(p);
+            streams.push(r);
+        }
+        let pass = ImagePass {
+            scene: job.scene,
+            width: job.grid.width,
+            height: job.grid.height,
+            camera_position: job.settings.camera.position,
+            points: &points,
+            streams: &streams,
+            seed: job.settings.seed,
+            sample_index,
+            pool,
+            counters: Mutex::new(Counters::default()),
+        };
+        let direct = strategy.estimate_image(&pass);
+        if direct.len() != n {
+            return Err(format!(
+                "strategy {}: its image-space pass returned {} pixels, not {n}",
+                job.strategy.name(),
+                direct.len()
+            ));
+        }
+        counters.merge(
+            &pass
+                .counters
+                .into_inner()
+                .unwrap_or_else(|e| e.into_inner()),
+        );
+        let mut splats = self.splats.iter_mut();
+        for (((px, mut s), sp), (l, aux)) in
+            self.accum.iter_mut().zip(samples).zip(&points).zip(direct)
+        {
+            if sp.is_some() {
+                s.camera.direct = l;
+                s.aux = aux;
+            }
+            job.accumulate(px, splats.next(), s, pass_weight);
+        }
+        Ok(())
+    }
+}
