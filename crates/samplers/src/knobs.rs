@@ -4,6 +4,7 @@
 use crate::StrategyOptions;
 use crate::brdf_oriented::{BoImportance, BrdfIntegral};
 use crate::learned::{LearnTarget, PassWeights};
+use crate::reuse::config::CandidateSourceKind;
 use crate::rivals::slc_minmax::SlcDescent;
 
 /// What a knob's flag takes.
@@ -328,6 +329,61 @@ pub static KNOBS: &[Knob] = &[
         set: |o, s| {
             let names = SlcDescent::ALL.map(SlcDescent::name);
             o.slc_descent = choice(s, &names, SlcDescent::from_name)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "restir-candidates",
+        help: "ReSTIR: light candidates per pixel (M), resampled with one BSDF candidate into the pixel's first reservoir.",
+        kind: KnobKind::Number,
+        value: |o| o.reuse.candidates.to_string(),
+        set: |o, s| {
+            o.reuse.candidates = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "restir-source",
+        help: "ReSTIR: where the light candidates come from, `power` (lights by power, as the paper) or `tree` (one light-tree descent).",
+        kind: KnobKind::Choice(|| {
+            CandidateSourceKind::ALL
+                .map(CandidateSourceKind::name)
+                .to_vec()
+        }),
+        value: |o| o.reuse.source.name().to_string(),
+        set: |o, s| {
+            let names = CandidateSourceKind::ALL.map(CandidateSourceKind::name);
+            o.reuse.source = choice(s, &names, CandidateSourceKind::from_name)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "restir-neighbours",
+        help: "ReSTIR: neighbours drawn per round of spatial reuse (0 to 32).",
+        kind: KnobKind::Number,
+        value: |o| o.reuse.neighbours.to_string(),
+        set: |o, s| {
+            o.reuse.neighbours = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "restir-radius",
+        help: "ReSTIR: radius in pixels of the disk the neighbours are drawn from.",
+        kind: KnobKind::Number,
+        value: |o| o.reuse.radius.to_string(),
+        set: |o, s| {
+            o.reuse.radius = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "restir-rounds",
+        help: "ReSTIR: rounds of spatial reuse, each reading only the previous round's reservoirs (0 to 8).",
+        kind: KnobKind::Number,
+        value: |o| o.reuse.rounds.to_string(),
+        set: |o, s| {
+            o.reuse.rounds = number(s)?;
             Ok(())
         },
     },

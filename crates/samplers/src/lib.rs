@@ -40,6 +40,7 @@ mod options;
 pub mod point_sets;
 pub mod registry;
 pub mod resolve;
+pub mod reuse;
 pub mod ris;
 pub mod rivals;
 mod scratch;

@@ -76,6 +76,8 @@ pub struct StrategyOptions {
     pub slc_descent: crate::rivals::slc_minmax::SlcDescent,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
     pub learned: learned::LearnedConfig,
+    /// The reuse strategies' parameters (`restir`, `restir-biased`).
+    pub reuse: crate::reuse::ReuseConfig,
 }
 
 /// Our default τ for the unit-free E&K cut, chosen by the equal-time sweep of
@@ -145,6 +147,7 @@ impl Default for StrategyOptions {
             slc_cut_size: DEFAULT_CUT_SIZE,
             slc_descent: Default::default(),
             learned: learned::LearnedConfig::default(),
+            reuse: Default::default(),
         }
     }
 }

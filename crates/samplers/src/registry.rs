@@ -36,6 +36,8 @@ pub static STRATEGIES: &[&Strategy] = &[
     &rivals::slc::SLC,
     &rivals::slc::SLC_BSDF,
     &rivals::slc::SLC_BO_BSDF,
+    &crate::reuse::strategy::RESTIR,
+    &crate::reuse::strategy::RESTIR_BIASED,
 ];
 
 /// The strategy `--strategy name` means: its own name first, then the other names it answers to;

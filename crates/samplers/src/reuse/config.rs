@@ -1,0 +1,95 @@
+//! The reuse strategies' parameters (`--restir-*`), with Bitterli et al. 2020's defaults.
+use serde::{Deserialize, Serialize};
+
+/// Where a pixel's light candidates come from.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CandidateSourceKind {
+    /// Lights ∝ power (an alias table), points by each light's own sampling (the paper's
+    /// candidates, which it draws ∝ power and area).
+    #[default]
+    Power,
+    /// One descent of the light tree (Conty Estevez & Kulla's importance).
+    Tree,
+}
+
+impl CandidateSourceKind {
+    /// Every source, in the order `--help` lists them.
+    pub const ALL: [CandidateSourceKind; 2] =
+        [CandidateSourceKind::Power, CandidateSourceKind::Tree];
+
+    /// The name `--restir-source` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            CandidateSourceKind::Power => "power",
+            CandidateSourceKind::Tree => "tree",
+        }
+    }
+
+    /// The source named `s`.
+    pub fn from_name(s: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == s)
+    }
+}
+
+/// How ReSTIR draws and shares its samples.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ReuseConfig {
+    /// Light candidates per pixel (M; the paper's 32), plus one BSDF candidate.
+    pub candidates: u32,
+    /// Where the light candidates come from.
+    pub source: CandidateSourceKind,
+    /// Neighbours per round of spatial reuse (the paper's 5).
+    pub neighbours: u32,
+    /// Radius in pixels the neighbours are drawn from (the paper's 30).
+    pub radius: f32,
+    /// Rounds of spatial reuse (the paper's 2).
+    pub rounds: u32,
+}
+
+impl Default for ReuseConfig {
+    fn default() -> Self {
+        ReuseConfig {
+            candidates: 32,
+            source: CandidateSourceKind::Power,
+            neighbours: 5,
+            radius: 30.0,
+            rounds: 2,
+        }
+    }
+}
+
+impl ReuseConfig {
+    /// Refuses values outside what the strategies take.
+    pub fn check(&self) -> Result<(), String> {
+        if !(1..=1024).contains(&self.candidates) {
+            return Err(format!(
+                "--restir-candidates must be 1 to 1024, got {}",
+                self.candidates
+            ));
+        }
+        if self.neighbours > MAX_NEIGHBOURS as u32 {
+            return Err(format!(
+                "--restir-neighbours must be 0 to {MAX_NEIGHBOURS}, got {}",
+                self.neighbours
+            ));
+        }
+        if !(self.radius >= 1.0 && self.radius <= 1024.0) {
+            return Err(format!(
+                "--restir-radius must be 1 to 1024 pixels, got {}",
+                self.radius
+            ));
+        }
+        if self.rounds > 8 {
+            return Err(format!(
+                "--restir-rounds must be 0 to 8, got {}",
+                self.rounds
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Most neighbours per round.
+pub const MAX_NEIGHBOURS: usize = 32;

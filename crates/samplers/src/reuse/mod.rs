@@ -1,0 +1,17 @@
+//! Samples shared between pixels: ReSTIR DI's spatial reuse on the render loop's image-space
+//! passes (`render_core::image_space`).
+//!
+//! * [`light_point`]: a sample as a point on a light (area measure), the target p̂ and its
+//!   shadow ray.
+//! * [`reservoir`]: weighted reservoir sampling and the contribution weight W.
+//! * [`initial`]: a pixel's candidates (M light + one BSDF) resampled into its first reservoir.
+//! * [`spatial`]: neighbours and one round of reuse, unbiased (pairwise MIS) or the paper's 1/M.
+//! * [`strategy`]: `restir`, `restir-biased`; [`config`]: their `--restir-*` parameters.
+pub mod config;
+pub mod initial;
+pub mod light_point;
+pub mod reservoir;
+pub mod spatial;
+pub mod strategy;
+
+pub use config::ReuseConfig;
