@@ -38,6 +38,7 @@ pub static STRATEGIES: &[&Strategy] = &[
     &rivals::slc::SLC_BO_BSDF,
     &crate::reuse::strategy::RESTIR,
     &crate::reuse::strategy::RESTIR_BIASED,
+    &crate::reuse::strategy::RESTIR_BO,
 ];
 
 /// The strategy `--strategy name` means: its own name first, then the other names it answers to;

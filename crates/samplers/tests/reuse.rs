@@ -93,6 +93,13 @@ fn restir_converges_to_the_image_of_power_bsdf() {
         ),
         ("restir", ReuseConfig { rounds: 0, ..d() }),
         (
+            "restir-bo",
+            ReuseConfig {
+                candidates: 8,
+                ..d()
+            },
+        ),
+        (
             "restir",
             ReuseConfig {
                 neighbours: 3,
@@ -136,7 +143,7 @@ fn the_biased_combination_is_caught() {
 #[test]
 fn restir_image_is_identical_for_any_thread_count() {
     let scene = common::mixed_scene(10);
-    for name in ["restir", "restir-biased"] {
+    for name in ["restir", "restir-biased", "restir-bo"] {
         let o = StrategyOptions::default();
         let a = common::render_opts(&scene, name, &o, 2, 1, 7, None);
         let b = common::render_opts(&scene, name, &o, 2, 2, 7, None);

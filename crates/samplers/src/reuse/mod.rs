@@ -6,11 +6,14 @@
 //! * [`reservoir`]: weighted reservoir sampling and the contribution weight W.
 //! * [`initial`]: a pixel's candidates (M light + one BSDF) resampled into its first reservoir.
 //! * [`spatial`]: neighbours and one round of reuse, unbiased (pairwise MIS) or the paper's 1/M.
-//! * [`strategy`]: `restir`, `restir-biased`; [`config`]: their `--restir-*` parameters.
+//! * [`sources`]: where the first candidates come from (a light selection, or the paper's
+//!   BO + tree techniques).
+//! * [`strategy`]: `restir`, `restir-biased`, `restir-bo`; [`config`]: their `--restir-*` parameters.
 pub mod config;
 pub mod initial;
 pub mod light_point;
 pub mod reservoir;
+pub mod sources;
 pub mod spatial;
 pub mod strategy;
 

@@ -10,14 +10,22 @@
 //! uses the pairwise MIS weights of GRIS (Lin et al. 2022) with the shadow rays they need
 //! instead of the paper's 1/Z count, which `restir-biased`'s 1/M form drops.
 //!
+//! `restir-bo` draws its candidates with the paper's techniques instead (`sources::FromBo`):
+//! at glossy points half BRDF-oriented samples from the BO cut and half light-tree samples
+//! (a fixed split, where the paper's allocation adapts it), tree samples elsewhere, their
+//! mixture density in every candidate's weight, so a neighbour reuses a glossy pixel's BO sample.
+//!
 //! `estimate` alone (a single shading point, no neighbours) is the initial reservoir's
 //! estimate: unbiased RIS with M + 1 candidates, used by tools that shade single points.
 use super::config::{CandidateSourceKind, ReuseConfig};
-use super::initial::{Candidates, SelectionCandidates, initial_reservoir};
 use super::light_point::{occluded, target};
 use super::reservoir::Reservoir;
+use super::sources::{FromBo, FromSelection, InitialSource};
 use super::spatial::{biased_round, neighbours, pairwise_round, shade};
-use crate::baselines::selection::{LightSelection, PowerSelection};
+use crate::baselines::selection::PowerSelection;
+use crate::brdf_oriented::BrdfIntegral;
+use crate::ris::CandidateCount;
+use crate::ris::strategy::Ris;
 use crate::strategy::Strategy;
 use crate::tree_selection::{TreeMode, TreeSelection};
 use crate::{StrategyError, StrategyOptions};
@@ -27,24 +35,23 @@ use render_core::image_space::{ImagePass, ImageSpaceLighting};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
-use std::cell::RefCell;
 
 /// Index of the neighbours reused in the technique counters (after the two candidate kinds).
 pub const TECHNIQUE_NEIGHBOURS: usize = 2;
 
-/// ReSTIR DI over a light selection `S`.
-pub struct ReStir<S: LightSelection> {
+/// ReSTIR DI.
+pub struct ReStir {
     /// The registered name.
     pub name: String,
-    /// Where the light candidates come from.
-    pub selection: S,
+    /// Where the first reservoirs come from.
+    pub source: Box<dyn InitialSource>,
     /// Candidates, neighbours, radius, rounds.
     pub config: ReuseConfig,
     /// The paper's 1/M combination instead of the unbiased pairwise one.
     pub biased: bool,
 }
 
-impl<S: LightSelection> ReStir<S> {
+impl ReStir {
     /// The pixel's initial reservoir, its sample shadow-tested (W = 0 when hidden).
     fn visible_initial(
         &self,
@@ -53,16 +60,9 @@ impl<S: LightSelection> ReStir<S> {
         rng: &mut SampleStream,
         c: &mut Counters,
     ) -> Reservoir {
-        let source = SelectionCandidates {
-            scene,
-            sp,
-            selection: &self.selection,
-            state: self.selection.prepare(scene, sp),
-            m: self.config.candidates,
-            picks: RefCell::new(Vec::with_capacity(1)),
-        };
-        debug_assert_eq!(source.count(), self.config.candidates);
-        let mut r = initial_reservoir(scene, sp, &source, true, rng, c);
+        let mut r = self
+            .source
+            .initial(scene, sp, self.config.candidates, rng, c);
         if r.w > 0.0 {
             match target(scene, sp, &r.y) {
                 Some((_, _, seen)) if !occluded(scene, sp, &r.y, &seen, c) => {}
@@ -73,7 +73,7 @@ impl<S: LightSelection> ReStir<S> {
     }
 }
 
-impl<S: LightSelection> DirectLighting for ReStir<S> {
+impl DirectLighting for ReStir {
     fn name(&self) -> String {
         self.name.clone()
     }
@@ -105,7 +105,7 @@ impl<S: LightSelection> DirectLighting for ReStir<S> {
     }
 }
 
-impl<S: LightSelection> ImageSpaceLighting for ReStir<S> {
+impl ImageSpaceLighting for ReStir {
     fn estimate_image(&self, pass: &ImagePass) -> Vec<(Vec3, [f32; MAX_AUX])> {
         let mut cur: Vec<Reservoir> = pass.run(0, |i, rng, c| match &pass.points[i] {
             Some(sp) => self.visible_initial(pass.scene, sp, rng, c),
@@ -140,10 +140,57 @@ impl<S: LightSelection> ImageSpaceLighting for ReStir<S> {
 }
 
 fn resolve(name: &str, opts: &StrategyOptions) -> serde_json::Value {
-    serde_json::json!({
+    let mut v = serde_json::json!({
         "reuse": opts.reuse,
         "biased": name == RESTIR_BIASED.name,
         "power_units": crate::resolve::units(opts),
+    });
+    if name == RESTIR_BO.name {
+        v["reuse"]["source"] = "tree+bo".into();
+        v["delta"] = opts.delta.into();
+        v["max_cut"] = opts.max_cut.into();
+        v["integral"] = crate::resolve::integral(&StrategyOptions {
+            reproduce: false,
+            ..opts.clone()
+        });
+    }
+    v
+}
+
+/// The first reservoirs' source of strategy `name` under `opts`.
+fn source(
+    name: &str,
+    scene: &Scene,
+    opts: &StrategyOptions,
+) -> Result<Box<dyn InitialSource>, StrategyError> {
+    let tree = || {
+        TreeSelection::new(scene, TreeMode::Single, opts.power_units())
+            .map_err(StrategyError::BadOption)
+    };
+    if name == RESTIR_BO.name {
+        fn ris<C: brdf_integrals::CapIntegral>(
+            opts: &StrategyOptions,
+            tree: Option<light_tree::LightTree>,
+            integral: C,
+        ) -> Ris<C> {
+            Ris {
+                name: RESTIR_BO.name.into(),
+                tree,
+                integral,
+                count: CandidateCount::Fixed(opts.reuse.candidates),
+                delta: opts.delta,
+                max_cut: opts.max_cut,
+            }
+        }
+        let t = tree()?.tree;
+        return Ok(match opts.brdf_integral {
+            BrdfIntegral::Sptd => Box::new(FromBo(ris(opts, t, brdf_integrals::Sptd::default()))),
+            BrdfIntegral::Ltc => Box::new(FromBo(ris(opts, t, brdf_integrals::Ltc::default()))),
+        });
+    }
+    Ok(match opts.reuse.source {
+        CandidateSourceKind::Power => Box::new(FromSelection(PowerSelection::new(scene))),
+        CandidateSourceKind::Tree => Box::new(FromSelection(tree()?)),
     })
 }
 
@@ -153,22 +200,12 @@ fn build(
     opts: &StrategyOptions,
 ) -> Result<Box<dyn DirectLighting>, StrategyError> {
     opts.reuse.check().map_err(StrategyError::BadOption)?;
-    let (config, biased) = (opts.reuse.clone(), name == RESTIR_BIASED.name);
-    Ok(match opts.reuse.source {
-        CandidateSourceKind::Power => Box::new(ReStir {
-            name: name.into(),
-            selection: PowerSelection::new(scene),
-            config,
-            biased,
-        }),
-        CandidateSourceKind::Tree => Box::new(ReStir {
-            name: name.into(),
-            selection: TreeSelection::new(scene, TreeMode::Single, opts.power_units())
-                .map_err(StrategyError::BadOption)?,
-            config,
-            biased,
-        }),
-    })
+    Ok(Box::new(ReStir {
+        name: name.into(),
+        source: source(name, scene, opts)?,
+        config: opts.reuse.clone(),
+        biased: name == RESTIR_BIASED.name,
+    }))
 }
 
 const KNOBS: &[&str] = &[
@@ -177,6 +214,16 @@ const KNOBS: &[&str] = &[
     "restir-neighbours",
     "restir-radius",
     "restir-rounds",
+];
+
+const BO_KNOBS: &[&str] = &[
+    "restir-candidates",
+    "restir-neighbours",
+    "restir-radius",
+    "restir-rounds",
+    "delta",
+    "max-cut",
+    "brdf-integral",
 ];
 
 /// `restir`: unbiased spatial reuse.
@@ -196,6 +243,18 @@ pub const RESTIR_BIASED: Strategy = Strategy {
     ..Strategy::new(
         "restir-biased",
         "restir with the paper's biased 1/M combination (darkens where neighbours differ; not unbiased)",
+        resolve,
+        build,
+    )
+};
+
+/// `restir-bo`: the paper's BRDF-oriented candidates inside unbiased ReSTIR.
+pub const RESTIR_BO: Strategy = Strategy {
+    knobs: BO_KNOBS,
+    golden_variants: &["ltc"],
+    ..Strategy::new(
+        "restir-bo",
+        "restir whose candidates are Liu et al.'s: BRDF-oriented (BO cut) + light-tree samples at glossy points, tree samples elsewhere, + 1 BSDF; shared between pixels",
         resolve,
         build,
     )
