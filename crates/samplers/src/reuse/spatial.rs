@@ -23,6 +23,9 @@ use render_core::image_space::ImagePass;
 use render_core::rng::SampleStream;
 use render_core::stats::Counters;
 
+/// Index of the neighbours' samples the pixel sees (and reflects) in the technique counters.
+pub const TECHNIQUE_SEEN: usize = 3;
+
 /// Normals further apart than this (cos 25°) make a neighbour unlike the pixel (the paper's test).
 const MIN_NORMAL_COS: f32 = 0.906;
 /// Depths further apart than this fraction make a neighbour unlike the pixel (the paper's test).
@@ -127,6 +130,7 @@ pub fn pairwise_round(
         let pj_yj = target(pass.scene, spj, &rj.y).map_or(0.0, |t| t.0);
         let p0_yj = seen_target(pass, sp0, &rj, c);
         if pj_yj > 0.0 && p0_yj > 0.0 {
+            c.technique_samples[TECHNIQUE_SEEN] += 1;
             let mj = pair_weights(pair, (rj.c, pj_yj), (c0k, p0_yj)).0;
             stream.offer(rj.y, mj * p0_yj * rj.w, p0_yj, u);
         }

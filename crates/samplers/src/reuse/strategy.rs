@@ -83,7 +83,12 @@ impl DirectLighting for ReStir {
     }
 
     fn techniques(&self) -> Vec<&'static str> {
-        vec!["light candidates", "bsdf candidates", "neighbours"]
+        vec![
+            "light candidates",
+            "bsdf candidates",
+            "neighbours",
+            "neighbour samples seen",
+        ]
     }
 
     fn estimate(
@@ -251,6 +256,8 @@ pub const RESTIR_BIASED: Strategy = Strategy {
 /// `restir-bo`: the paper's BRDF-oriented candidates inside unbiased ReSTIR.
 pub const RESTIR_BO: Strategy = Strategy {
     knobs: BO_KNOBS,
+    // Ours, like the method it carries: the emission seen directly gathered as `mis3` does.
+    emission_rays: crate::brdf_oriented::strategies::METHOD_EMISSION_RAYS,
     golden_variants: &["ltc"],
     ..Strategy::new(
         "restir-bo",
