@@ -190,6 +190,39 @@ fn cpu_clock_budget_stops_after_its_cpu_time_per_thread() {
     assert!(meta["spp"].as_u64().unwrap() >= 2);
 }
 
+/// A strategy on the image-space passes stops between passes under a time budget (never inside
+/// one: no partial pixels) and records the memory its passes hold per pixel; a bad `--restir-*`
+/// value is one line.
+#[test]
+fn image_space_strategy_keeps_its_budget_and_records_its_memory() {
+    let dir = temp_dir("image-space");
+    let meta = render_with_budget(&dir, "0.3", &["--strategy", "restir", "--threads", "2"]);
+    assert!(meta["spp"].as_u64().unwrap() >= 1, "{meta}");
+    assert_eq!(meta["partial_pass_pixels"], 0, "{meta}");
+    assert!(
+        meta["image_space_bytes_per_pixel"].as_u64().unwrap() > 0,
+        "{meta}"
+    );
+    let plain = render_with_budget(&dir, "0.1", &[]);
+    assert!(plain["image_space_bytes_per_pixel"].is_null());
+    let bad = temp_dir("image-space-bad");
+    let out = bad.join("bad.exr");
+    assert_clean_failure(
+        &bad,
+        &[
+            "render",
+            SCENE,
+            "--strategy",
+            "restir",
+            "--restir-neighbours",
+            "99",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "--restir-neighbours must be 0 to 32",
+    );
+}
+
 /// Runs a command that must fail with one clear line and leave no output file behind.
 fn assert_clean_failure(dir: &Path, args: &[&str], expect: &str) {
     let o = manylights(args);

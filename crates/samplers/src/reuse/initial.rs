@@ -53,7 +53,9 @@ impl<S: LightSelection> Candidates for SelectionCandidates<'_, S> {
         picks.clear();
         self.selection.pick(&self.state, self.sp, rng, &mut picks);
         let &(light, _) = picks.first()?;
-        let s = self.scene.lights[light as usize].sample(self.sp.point(), rng.next_2d())?;
+        let s = self
+            .scene
+            .sample_light(light, self.sp.point(), rng.next_2d())?;
         Some(LightPoint {
             light,
             point: s.point,
