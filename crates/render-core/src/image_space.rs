@@ -10,7 +10,8 @@
 //! an independent stream of its own. So the image is bit-identical whatever the thread count.
 //!
 //! What differs from the per-sample path: a time budget is checked between passes only (a
-//! pass is never cut short, so it is overrun by at most one pass), a strategy's per-pixel
+//! pass is never cut short; another starts while at least half of the last one's time is
+//! left, so the budget is missed by at most half a pass either way), a strategy's per-pixel
 //! memory and pilot are not offered, and the passes' pixels are no longer independent (a
 //! pixel's estimate uses its neighbours' samples of the same pass; passes stay independent).
 use crate::estimator::{MAX_AUX, ShadingPoint};

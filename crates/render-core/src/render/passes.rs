@@ -61,6 +61,7 @@ impl Passes {
     ) -> Result<(), String> {
         let stop = AtomicBool::new(false);
         let image_space = job.strategy.image_space();
+        let mut pass_started = 0.0;
         loop {
             if let Some(limit) = job.settings.spp
                 && self.spp_done >= limit
@@ -70,12 +71,19 @@ impl Passes {
             if stop.load(Ordering::Relaxed) {
                 break;
             }
-            // An image-space pass is never cut short: its budget is checked between passes.
+            // An image-space pass is never cut short: another one starts while at least half
+            // of the last one's time is left, so the budget is missed by at most half a pass.
             if let (Some(_), Some(clock)) = (image_space, clock)
                 && self.passes > 0
-                && clock.spent(&mut None)
             {
-                break;
+                let elapsed = clock.elapsed();
+                let last_pass = elapsed - pass_started;
+                if elapsed + 0.5 * last_pass >= clock.budget.seconds {
+                    break;
+                }
+            }
+            if image_space.is_some() {
+                pass_started = clock.map_or(0.0, |c| c.elapsed());
             }
             let pass_weight = job.pass_weight(self.spp_done)?;
             self.weights.push(pass_weight);

@@ -92,6 +92,18 @@ pub(super) struct BudgetClockReader {
 }
 
 impl BudgetClockReader {
+    /// Seconds spent so far by the budget's clock (CPU: per worker thread; wall time where the
+    /// platform has no CPU clock).
+    pub(super) fn elapsed(&self) -> f64 {
+        let wall = self.start.elapsed().as_secs_f64();
+        match (self.budget.clock, process_cpu_seconds(), self.cpu_start) {
+            (BudgetClock::Cpu, Some(now), Some(start)) => {
+                (now - start) / self.threads.max(1) as f64
+            }
+            _ => wall,
+        }
+    }
+
     /// `last_cpu_read`: this thread's last reading of the CPU clock, so that the /proc read
     /// happens at most every [`CPU_CLOCK_INTERVAL`] per thread.
     pub(super) fn spent(&self, last_cpu_read: &mut Option<Instant>) -> bool {
