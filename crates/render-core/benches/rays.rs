@@ -166,7 +166,7 @@ fn emissive_mesh_rays() -> (Scene, Vec<Segment>, Vec<Segment>) {
         }
         let light = (rng.next_f32() * scene.lights.len() as f32) as u32;
         let light = light.min(scene.lights.len() as u32 - 1);
-        if let Some(s) = scene.sample_light(light, hit.point, rng.next_2d()) {
+        if let Some(s) = scene.sample_light(light, hit.point, hit.ns, rng.next_2d()) {
             let d = s.point - hit.point;
             let dist = d.length();
             if dist > 0.0 {

@@ -26,6 +26,11 @@ impl ShadingPoint {
         self.hit.point
     }
 
+    /// The shading normal on the viewer's side: the receiver's normal of light sampling.
+    pub fn normal(&self) -> Vec3 {
+        self.bsdf.frame.z
+    }
+
     /// Ray origin for a ray leaving in direction `w`.
     pub fn origin_towards(&self, w: Vec3) -> Vec3 {
         offset_origin(self.hit.point, self.hit.ng, w)

@@ -139,22 +139,28 @@ impl TriangleRecord {
 
 /// A point drawn uniformly by area on a triangle, as seen from `x`: the geometry that
 /// [`Light::sample`] and [`TriangleRecord::sample`] share, before the emission is looked up.
-struct TrianglePoint {
+pub(crate) struct TrianglePoint {
     /// Barycentric coordinates of the point (of `p[1]` and `p[2]`).
-    b: Vec2,
-    point: Vec3,
-    wi: Vec3,
-    dist: f32,
+    pub(crate) b: Vec2,
+    pub(crate) point: Vec3,
+    pub(crate) wi: Vec3,
+    pub(crate) dist: f32,
     /// Cosine at the light between its normal and the direction back to `x`.
-    cos_l: f32,
+    pub(crate) cos_l: f32,
     /// Solid-angle density at `x`.
-    pdf: f32,
+    pub(crate) pdf: f32,
 }
 
 impl TrianglePoint {
     /// `None` when `x` lies in the triangle's plane or on the point.
     #[inline]
-    fn sample(p: &[Vec3; 3], normal: Vec3, area: f32, x: Vec3, u: Vec2) -> Option<TrianglePoint> {
+    pub(crate) fn sample(
+        p: &[Vec3; 3],
+        normal: Vec3,
+        area: f32,
+        x: Vec3,
+        u: Vec2,
+    ) -> Option<TrianglePoint> {
         let b = sampling::uniform_triangle(u);
         let point = p[0] * (1.0 - b.x - b.y) + p[1] * b.x + p[2] * b.y;
         let d = point - x;
@@ -268,26 +274,29 @@ impl Light {
         }
     }
 
+    /// The sample of a point drawn on this triangle light: its emission towards the receiver
+    /// looked up (`None` where it emits nothing that way).
+    pub(crate) fn triangle_sample(&self, t: &TrianglePoint) -> Option<LightSample> {
+        let LightShape::Triangle { normal, uv, .. } = &self.shape else {
+            return None;
+        };
+        let b = t.b;
+        let tuv = uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y;
+        let radiance = self.emitted(*normal, tuv, -t.wi);
+        if radiance == Vec3::ZERO {
+            return None;
+        }
+        Some(t.light_sample(*normal, radiance))
+    }
+
     /// Sample a point on the light as seen from `x`: triangles uniformly by area, spheres
     /// uniformly in the cone of directions they subtend. `None` when nothing can be sampled
     /// or the sampled point emits nothing towards `x`.
     pub fn sample(&self, x: Vec3, u: Vec2) -> Option<LightSample> {
         match &self.shape {
             LightShape::Triangle {
-                p,
-                normal,
-                area,
-                uv,
-            } => {
-                let t = TrianglePoint::sample(p, *normal, *area, x, u)?;
-                let b = t.b;
-                let tuv = uv[0] * (1.0 - b.x - b.y) + uv[1] * b.x + uv[2] * b.y;
-                let radiance = self.emitted(*normal, tuv, -t.wi);
-                if radiance == Vec3::ZERO {
-                    return None;
-                }
-                Some(t.light_sample(*normal, radiance))
-            }
+                p, normal, area, ..
+            } => self.triangle_sample(&TrianglePoint::sample(p, *normal, *area, x, u)?),
             LightShape::Sphere { center, radius } => {
                 let d = *center - x;
                 let dist_c = d.length();

@@ -3,7 +3,7 @@
 use crate::accel::{Accel, Primitive};
 use crate::camera::Camera;
 use crate::error::SceneError;
-use crate::light::{DistantLight, Light, LightSample, LightShape, SpotCone, TriangleRecord};
+use crate::light::{DistantLight, Light, LightShape, SpotCone, TriangleRecord};
 use crate::material::Material;
 use glam::{Mat4, Vec2, Vec3};
 use serde::Serialize;
@@ -73,6 +73,9 @@ pub struct Scene {
     /// The sampler and filter the scene file asks for, if any.
     pub render_hints: crate::scene_hints::RenderHints,
     pub accel: Accel,
+    /// How points on triangle lights are drawn ([`Scene::sample_light`]): a render's choice,
+    /// set before it starts.
+    pub light_points: crate::light_points::LightPoints,
 }
 
 impl Scene {
@@ -110,18 +113,6 @@ impl Scene {
                 material: None,
                 light,
             }
-        }
-    }
-
-    /// [`Light::sample`] of light `light`, through its one-cache-line record when it is a
-    /// plain triangle (the same result, bit for bit).
-    #[inline]
-    pub fn sample_light(&self, light: u32, x: Vec3, u: glam::Vec2) -> Option<LightSample> {
-        let rec = &self.triangle_records[light as usize];
-        if rec.is_plain_triangle() {
-            rec.sample(x, u)
-        } else {
-            self.lights[light as usize].sample(x, u)
         }
     }
 
@@ -591,6 +582,7 @@ impl SceneBuilder {
             stats: self.stats,
             render_hints: self.render_hints,
             accel,
+            light_points: Default::default(),
         })
     }
 }

@@ -31,7 +31,7 @@ fn trace(scene: &Scene) -> (Vec<HitBits>, Vec<bool>) {
         if !scene.lights.is_empty() {
             let light = ((rng.next_f32() * scene.lights.len() as f32) as u32)
                 .min(scene.lights.len() as u32 - 1);
-            if let Some(ls) = scene.sample_light(light, s.point, rng.next_2d()) {
+            if let Some(ls) = scene.sample_light(light, s.point, s.ns, rng.next_2d()) {
                 let d = ls.point - s.point;
                 let dist = d.length();
                 if dist > 0.0 {

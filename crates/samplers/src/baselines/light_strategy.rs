@@ -63,7 +63,7 @@ fn sample_pick_at(
     u: Vec2,
     counters: &mut Counters,
 ) -> Option<(LightSample, f32, Vec3, f32)> {
-    let s = scene.sample_light(light, sp.point(), u)?;
+    let s = scene.sample_light(light, sp.point(), sp.normal(), u)?;
     let p = pmf * s.pdf;
     if !(p > 0.0) {
         return None;
@@ -124,7 +124,7 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
             let b = sample_bsdf_at(scene, sp, u_lobe, u, ctx.counters)?;
             b.found_light().then(|| {
                 let p_light = self.selection.pmf(&state, sp, b.light)
-                    * scene.lights[b.light as usize].pdf(sp.point(), b.point, b.normal);
+                    * scene.light_pdf(b.light, sp.point(), sp.normal(), b.point, b.normal);
                 b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf)
             })
         });

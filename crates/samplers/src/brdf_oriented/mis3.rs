@@ -92,7 +92,7 @@ impl<C: CapIntegral, S: LsTechnique> Mis3<C, S>
 where
     C::Lobe: LobePivot + LobeDensity,
 {
-    fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<'_, C::Lobe>> {
+    fn bo_state(&self, scene: &Scene, sp: &ShadingPoint) -> Option<BoState<'_, C::Lobe>> {
         let tree = self.ls.tree()?;
         let wo_local = sp.bsdf.frame.to_local(sp.wo);
         let lobe = self.integral.lobe(wo_local, sp.bsdf.params.alpha);
@@ -112,7 +112,8 @@ where
                 self.config.max_cut_bo,
                 pivot,
             )
-            .with_four_wide_descent(self.config.four_wide_bo_descent),
+            .with_four_wide_descent(self.config.four_wide_bo_descent)
+            .with_light_points(scene.light_points),
         )
     }
 }
@@ -334,7 +335,7 @@ where
         rng: &mut SampleStream,
         ctx: &mut SampleContext,
     ) -> Vec3 {
-        let Some(bo) = self.bo_state(sp) else {
+        let Some(bo) = self.bo_state(scene, sp) else {
             return Vec3::ZERO;
         };
         ctx.counters.technique_samples[0] += 1;
@@ -370,7 +371,7 @@ where
         let bo = if sp.bsdf.is_pure_diffuse() {
             None
         } else {
-            self.bo_state(sp)
+            self.bo_state(scene, sp)
         };
         let one_descent = bo.is_some() && self.config.single_ls_at_glossy;
         let ls_state = self.ls.prepare_ls(scene, sp, one_descent);

@@ -10,7 +10,8 @@ use crate::scratch::Pooled;
 use brdf_integrals::LobeIntegral;
 use light_tree::{DescentRandom, Fresh, LightTree, NO_NODE, NodeId, Rescaled};
 use render_core::Vec3;
-use render_core::light::{Light, LightSample};
+use render_core::light::{Light, LightSample, LightShape};
+use render_core::light_points::LightPoints;
 use render_core::rng::SampleStream;
 use std::cell::RefCell;
 
@@ -83,6 +84,8 @@ pub struct BoState<'a, L> {
     pub pivot: Option<PivotSphere>,
     /// The SG importance that replaces I_BO in the cluster choice and the descent, if chosen.
     sg: Option<SgImportance<'a>>,
+    /// How points on triangle lights are drawn (pivot-sphere sampling aside).
+    points: LightPoints,
     /// The descent below the cut is the tree's four-wide one (`LightTree::sample_quads`);
     /// off: the binary one (`LightTree::sample_subtree`).
     four_wide: bool,
@@ -118,6 +121,7 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
             rec,
             scratch,
             pivot,
+            points: LightPoints::Area,
             four_wide: sg.is_none(),
             sg,
         }
@@ -127,6 +131,12 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
     /// or binary (the paper's, one level at a time). Sampling and every pmf replay use it.
     pub fn with_four_wide_descent(mut self, four_wide: bool) -> Self {
         self.four_wide = four_wide;
+        self
+    }
+
+    /// Chooses how points on triangle lights are drawn (the scene's, for its render).
+    pub fn with_light_points(mut self, points: LightPoints) -> Self {
+        self.points = points;
         self
     }
 
@@ -266,8 +276,10 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
     /// Samples a point on `light` (its own shape sampling, or the pivot-sphere mixture).
     pub fn sample_point(&self, light: &Light, rng: &mut SampleStream) -> Option<LightSample> {
         match &self.pivot {
-            Some(p) => p.sample(&self.rec, light, rng),
-            None => light.sample(self.rec.x, rng.next_2d()),
+            Some(p) if is_sphere(light) => p.sample(&self.rec, light, rng),
+            _ => self
+                .points
+                .sample(light, self.rec.x, self.rec.frame.z, rng.next_2d()),
         }
     }
 
@@ -277,8 +289,14 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
             return 1.0;
         }
         match &self.pivot {
-            Some(p) => p.pdf(&self.rec, light, point, normal, wi),
-            None => light.pdf(self.rec.x, point, normal),
+            Some(p) if is_sphere(light) => p.pdf(&self.rec, light, point, normal, wi),
+            _ => self
+                .points
+                .pdf(light, self.rec.x, self.rec.frame.z, point, normal),
         }
     }
+}
+
+fn is_sphere(light: &Light) -> bool {
+    matches!(light.shape, LightShape::Sphere { .. })
 }

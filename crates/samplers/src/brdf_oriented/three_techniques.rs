@@ -74,7 +74,7 @@ impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
             let p_pt = if delta {
                 1.0
             } else {
-                l.pdf(sp.point(), point, normal)
+                scene.light_pdf(light as u32, sp.point(), sp.normal(), point, normal)
             };
             self.ls.pmf(&self.ls_state, sp, light as u32) * p_pt
         };
@@ -123,7 +123,7 @@ impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
             debug_assert!(
                 {
                     let replay = self.ls.pmf(&self.ls_state, sp, light)
-                        * scene.lights[light as usize].pdf(sp.point(), s.point, s.normal);
+                        * scene.light_pdf(light, sp.point(), sp.normal(), s.point, s.normal);
                     s.is_delta || (replay - p_ls).abs() <= 1e-3 * p_ls
                 },
                 "LS pdf at sampling vs replay"

@@ -291,7 +291,7 @@ pub(crate) fn sample_observed<L: Learner>(
     sel: &L,
     state: &L::State,
 ) -> Option<(render_core::light::LightSample, f32, render_core::Vec3, f32)> {
-    let s = scene.sample_light(light, sp.point(), u)?;
+    let s = scene.sample_light(light, sp.point(), sp.normal(), u)?;
     let p = pmf * s.pdf;
     if !(p > 0.0) {
         return None;

@@ -99,7 +99,7 @@ impl<S: Learner> DirectLighting for LearnedStrategy<S> {
             let b = sample_bsdf_at(scene, sp, u_lobe, u, ctx.counters)?;
             b.found_light().then(|| {
                 let p_light = sel.pmf(&state, sp, b.light)
-                    * scene.lights[b.light as usize].pdf(sp.point(), b.point, b.normal);
+                    * scene.light_pdf(b.light, sp.point(), sp.normal(), b.point, b.normal);
                 let w = power_heuristic(1, &[(n as f32, p_light), (1.0, b.pdf)]);
                 b.f_cos * b.radiance * (w / b.pdf)
             })

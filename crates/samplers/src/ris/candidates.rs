@@ -25,6 +25,8 @@ pub struct CandidateSource<'a, L> {
     tree: &'a LightTree,
     x: Vec3,
     n: Vec3,
+    /// The shading normal, the receiver's of the scene's light point sampler.
+    ns: Vec3,
     /// The tree importances of this shading point, memoised (shared by draws and replays).
     memo: RefCell<Pooled<NodeMemo>>,
     bo: Option<&'a BoState<'a, L>>,
@@ -57,6 +59,7 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
             tree,
             x: sp.point(),
             n: sp.bsdf.ng,
+            ns: sp.normal(),
             memo: RefCell::new(Pooled::take()),
             bo,
             n_ls: m - n_bo,
@@ -103,7 +106,9 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
                 |c| self.tree_importance(c),
                 &mut Rescaled(u),
             )?;
-            let sample = self.scene.lights[light].sample(self.x, rng.next_2d())?;
+            let sample = self
+                .scene
+                .sample_light(light as u32, self.x, self.ns, rng.next_2d())?;
             Some(Drawn {
                 light: light as u32,
                 sample,
@@ -125,7 +130,7 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
         if delta || !(p_sel > 0.0) {
             return p_sel;
         }
-        p_sel * self.scene.lights[light as usize].pdf(self.x, point, normal)
+        p_sel * self.scene.light_pdf(light, self.x, self.ns, point, normal)
     }
 
     /// BO density of a light point (0 without a BO state).

@@ -88,7 +88,7 @@ where
     C::Lobe: LobePivot + LobeDensity,
 {
     /// The BO state of a point (none on pure diffuse points, as in `mis3`).
-    pub fn bo_state(&self, sp: &ShadingPoint) -> Option<BoState<'_, C::Lobe>> {
+    pub fn bo_state(&self, scene: &Scene, sp: &ShadingPoint) -> Option<BoState<'_, C::Lobe>> {
         let tree = self.tree.as_ref()?;
         if sp.bsdf.is_pure_diffuse() {
             return None;
@@ -97,7 +97,10 @@ where
             .integral
             .lobe(sp.bsdf.frame.to_local(sp.wo), sp.bsdf.params.alpha);
         let rec = BoRecord::new(sp, lobe, true, false);
-        Some(BoState::new(tree, rec, self.delta, self.max_cut, None))
+        Some(
+            BoState::new(tree, rec, self.delta, self.max_cut, None)
+                .with_light_points(scene.light_points),
+        )
     }
 }
 
@@ -135,7 +138,7 @@ where
         let Some(tree) = self.tree.as_ref() else {
             return Vec3::ZERO;
         };
-        let bo = self.bo_state(sp);
+        let bo = self.bo_state(scene, sp);
         let m = self
             .count
             .at(bo.as_ref().map_or(0.0, |b| b.cut().upper_bound()));
