@@ -115,6 +115,7 @@ pub(super) fn metadata(
             "reconstruction_from": reconstruction_from,
         },
         "emission_rays": settings.emission_rays.get(),
+        "light_points": scene.light_points.name(),
         "width": settings.width,
         "height": settings.height,
         "camera": settings.camera,
