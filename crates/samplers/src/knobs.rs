@@ -160,6 +160,16 @@ pub static KNOBS: &[Knob] = &[
         },
     },
     Knob {
+        flag: "ltc-triangles",
+        help: "BRDF-aware points on triangle lights: BO at glossy points draws the point by the glossy lobe's LTC over the triangle (Peters 2021, with a bilinear warp for the cosine), mixed one-to-one with --light-points.",
+        kind: KnobKind::Switch,
+        value: |o| o.ltc_triangles.to_string(),
+        set: |o, _| {
+            o.ltc_triangles = true;
+            Ok(())
+        },
+    },
+    Knob {
         flag: "no-adaptive-total",
         help: "Turn off heuristic 1 (N = floor(N_max·UB)); N = N_max/2 instead.",
         kind: KnobKind::Switch,

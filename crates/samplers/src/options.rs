@@ -46,6 +46,9 @@ pub struct StrategyOptions {
     pub reproduce: bool,
     /// Sample points on sphere lights by the pivot-transformed lobe (mixed with cone sampling).
     pub pivot_sphere: bool,
+    /// Sample points on triangle lights by the glossy lobe's LTC (BO at glossy points; mixed
+    /// with the render's point sampler).
+    pub ltc_triangles: bool,
     /// Heuristic 1: N = floor(N_max·UB); off: N = N_max/2.
     pub adaptive_total: bool,
     /// Heuristic 1 with UB times the glossy lobe's weight (Ks·F at θo), so that N follows the
@@ -136,6 +139,7 @@ impl Default for StrategyOptions {
             bo_importance: brdf_oriented::BoImportance::Cap,
             reproduce: false,
             pivot_sphere: false,
+            ltc_triangles: false,
             adaptive_total: true,
             weighted_ub: false,
             efficient_total: true,

@@ -23,6 +23,7 @@ pub fn bo_config(opts: &StrategyOptions) -> BoConfig {
         bo_importance: opts.bo_importance,
         reproduce: opts.reproduce,
         pivot_sphere: opts.pivot_sphere,
+        ltc_triangles: opts.ltc_triangles,
         adaptive_total: opts.adaptive_total,
         weighted_ub: opts.weighted_ub,
         efficient_total: opts.efficient_total && !opts.reproduce,

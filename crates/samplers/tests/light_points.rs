@@ -33,6 +33,29 @@ fn every_strategy_converges_under_every_point_sampler() {
     }
 }
 
+/// The method with BRDF-aware points on triangle lights, mixed with each point sampler.
+#[test]
+fn the_method_converges_with_ltc_points() {
+    let area = common::mixed_scene(20);
+    let reference = render(&area, "power+bsdf", 256, 1);
+    let opts = StrategyOptions {
+        ltc_triangles: true,
+        ..StrategyOptions::default()
+    };
+    for points in [LightPoints::Area, LightPoints::SolidAngle] {
+        let mut scene = common::mixed_scene(20);
+        scene.light_points = points;
+        let r = common::render_opts(&scene, "mis3-adaptive", &opts, 16, 2, 4, None);
+        let failures = compare(&reference, &r, 2, 3.0);
+        assert!(
+            failures.is_empty(),
+            "mis3-adaptive --ltc-triangles under {}:\n{}",
+            points.name(),
+            failures.join("\n")
+        );
+    }
+}
+
 /// The default draws what it always drew: `area` renders the image of a scene built without
 /// naming a point sampler, bit for bit, and another sampler renders a different one.
 #[test]

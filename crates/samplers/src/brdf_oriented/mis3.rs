@@ -6,6 +6,7 @@ use super::allocation::{
 use super::importance::{BoRecord, LobeDensity};
 use super::in_sample::in_sample_allocation;
 use super::ls_technique::LsTechnique;
+use super::ltc_triangle::LtcTriangle;
 use super::pivot_sphere::PivotSphere;
 use super::pixel_memory::{HITS, MISSES};
 use super::sg_importance::SgImportance;
@@ -113,7 +114,12 @@ where
                 pivot,
             )
             .with_four_wide_descent(self.config.four_wide_bo_descent)
-            .with_light_points(scene.light_points),
+            .with_light_points(scene.light_points)
+            .with_ltc_triangles(if self.config.ltc_triangles {
+                LtcTriangle::new(wo_local, sp.bsdf.params.alpha)
+            } else {
+                None
+            }),
         )
     }
 }

@@ -9,6 +9,7 @@
 //! * [`mis3`]: the strategies `brdf-oriented`, `mis3-equal`, `mis3-adaptive`.
 //! * [`quad_importance`]: I_BO of four nodes at once, for BO's four-wide descent.
 //! * [`pivot_sphere`]: optional pivot-transformed point sampling on sphere lights.
+//! * [`ltc_triangle`]: optional BRDF-aware (LTC) point sampling on triangle lights.
 //! * [`sg_importance`]: the SG node importance (Tokuyoshi et al. 2024) as BO's cluster and
 //!   descent importance (`--bo-importance sg`).
 pub mod allocation;
@@ -16,6 +17,7 @@ pub mod cut;
 pub mod importance;
 pub mod in_sample;
 pub mod ls_technique;
+pub mod ltc_triangle;
 pub mod mis3;
 pub mod pivot_sphere;
 pub mod pixel_memory;
@@ -136,6 +138,10 @@ pub struct BoConfig {
     pub reproduce: bool,
     /// Pivot-sphere point sampling on sphere lights.
     pub pivot_sphere: bool,
+    /// BRDF-aware (LTC) point sampling on triangle lights. Named only when on, so that the
+    /// parameters recorded before it existed keep their keys.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub ltc_triangles: bool,
     /// Heuristic 1 (N from UB); off: N = N_max/2.
     pub adaptive_total: bool,
     /// Heuristic 1's UB times the glossy lobe's weight (Ks·F at θo).

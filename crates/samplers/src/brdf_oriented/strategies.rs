@@ -21,6 +21,7 @@ const LEARNED_METHOD_KNOBS: &[&str] = &[
     "brdf-integral",
     "bo-importance",
     "pivot-sphere",
+    "ltc-triangles",
     "no-adaptive-total",
     "no-adaptive-split",
     "weighted-ub",
@@ -37,7 +38,7 @@ const LEARNED_METHOD_KNOBS: &[&str] = &[
 ];
 
 /// The method's knobs.
-const METHOD_KNOBS: &[&str] = LEARNED_METHOD_KNOBS.split_at(16).0;
+const METHOD_KNOBS: &[&str] = LEARNED_METHOD_KNOBS.split_at(17).0;
 
 /// `mis3-adaptive`'s camera rays per sample for the emission seen directly: its few spp per
 /// pixel leave the coverage noise of the pixels that see a light (the paper experiment chose it).

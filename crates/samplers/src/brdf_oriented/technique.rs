@@ -3,6 +3,7 @@
 //! Under `--bo-importance sg` the cluster choice and the descent use the SG importance instead.
 use super::cut::{BoCut, BoCutScratch};
 use super::importance::{BoRecord, LobeDensity};
+use super::ltc_triangle::LtcTriangle;
 use super::pivot_sphere::PivotSphere;
 use super::sg_importance::SgImportance;
 use crate::memo::{NodeMemo, QuadMemo};
@@ -86,6 +87,8 @@ pub struct BoState<'a, L> {
     sg: Option<SgImportance<'a>>,
     /// How points on triangle lights are drawn (pivot-sphere sampling aside).
     points: LightPoints,
+    /// BRDF-aware points on triangle lights (mixed with `points`), if enabled.
+    ltc: Option<LtcTriangle>,
     /// The descent below the cut is the tree's four-wide one (`LightTree::sample_quads`);
     /// off: the binary one (`LightTree::sample_subtree`).
     four_wide: bool,
@@ -122,6 +125,7 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
             scratch,
             pivot,
             points: LightPoints::Area,
+            ltc: None,
             four_wide: sg.is_none(),
             sg,
         }
@@ -137,6 +141,12 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
     /// Chooses how points on triangle lights are drawn (the scene's, for its render).
     pub fn with_light_points(mut self, points: LightPoints) -> Self {
         self.points = points;
+        self
+    }
+
+    /// Chooses BRDF-aware points on triangle lights (`--ltc-triangles`), or none.
+    pub fn with_ltc_triangles(mut self, ltc: Option<LtcTriangle>) -> Self {
+        self.ltc = ltc;
         self
     }
 
@@ -277,6 +287,10 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
     pub fn sample_point(&self, light: &Light, rng: &mut SampleStream) -> Option<LightSample> {
         match &self.pivot {
             Some(p) if is_sphere(light) => p.sample(&self.rec, light, rng),
+            _ if self.ltc.is_some() && !is_sphere(light) => {
+                let ltc = self.ltc.as_ref()?;
+                ltc.sample(&self.rec, light, self.points, rng)
+            }
             _ => self
                 .points
                 .sample(light, self.rec.x, self.rec.frame.z, rng.next_2d()),
@@ -290,9 +304,12 @@ impl<'a, L: LobeIntegral + LobeDensity> BoState<'a, L> {
         }
         match &self.pivot {
             Some(p) if is_sphere(light) => p.pdf(&self.rec, light, point, normal, wi),
-            _ => self
-                .points
-                .pdf(light, self.rec.x, self.rec.frame.z, point, normal),
+            _ => match &self.ltc {
+                Some(t) => t.pdf(&self.rec, light, self.points, point, normal),
+                None => self
+                    .points
+                    .pdf(light, self.rec.x, self.rec.frame.z, point, normal),
+            },
         }
     }
 }
