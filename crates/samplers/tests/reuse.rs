@@ -120,6 +120,24 @@ fn restir_converges_to_the_image_of_power_bsdf() {
     }
 }
 
+/// Under solid-angle points on the triangle lights (with the cosine warp) the candidates' and
+/// the BSDF candidate's densities are the chosen sampler's, and the image is the same.
+#[test]
+fn restir_converges_under_solid_angle_points() {
+    let mut scene = common::mixed_scene(20);
+    scene.light_points = render_core::light_points::LightPoints::SolidAngleWarp;
+    let reference = reference(&scene);
+    for name in ["restir", "restir-bo"] {
+        let reuse = ReuseConfig {
+            candidates: 8,
+            ..Default::default()
+        };
+        let z = z_scores(&scene, name, &opts(reuse), &reference, (16, 2));
+        eprintln!("{name}, solid-angle-warp points: z = {z:.2?}");
+        assert!(z.iter().all(|z| z.abs() <= Z), "{name}: z = {z:.2?}");
+    }
+}
+
 /// The paper's 1/M combination darkens pixels whose neighbours cannot see what they see: the
 /// same check must catch it.
 #[test]

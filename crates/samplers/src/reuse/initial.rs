@@ -55,7 +55,7 @@ impl<S: LightSelection> Candidates for SelectionCandidates<'_, S> {
         let &(light, _) = picks.first()?;
         let s = self
             .scene
-            .sample_light(light, self.sp.point(), rng.next_2d())?;
+            .sample_light(light, self.sp.point(), self.sp.normal(), rng.next_2d())?;
         Some(LightPoint {
             light,
             point: s.point,
@@ -68,8 +68,8 @@ impl<S: LightSelection> Candidates for SelectionCandidates<'_, S> {
         if seen.is_delta || !(pmf > 0.0) {
             return self.m as f32 * pmf;
         }
-        let light = &self.scene.lights[y.light as usize];
-        self.m as f32 * pmf * light.pdf(self.sp.point(), y.point, y.normal)
+        let (x, n) = (self.sp.point(), self.sp.normal());
+        self.m as f32 * pmf * self.scene.light_pdf(y.light, x, n, y.point, y.normal)
     }
 }
 

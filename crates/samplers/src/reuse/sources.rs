@@ -73,7 +73,7 @@ where
         let Some(tree) = self.0.tree.as_ref() else {
             return Reservoir::default();
         };
-        let bo = self.0.bo_state(sp);
+        let bo = self.0.bo_state(scene, sp);
         let source = CandidateSource::new(scene, tree, sp, bo.as_ref(), m);
         initial_reservoir(scene, sp, &source, true, rng, c)
     }
