@@ -5,6 +5,7 @@ use crate::StrategyOptions;
 use crate::brdf_oriented::{BoImportance, BrdfIntegral};
 use crate::learned::{LearnTarget, PassWeights};
 use crate::reuse::config::CandidateSourceKind;
+use crate::rivals::rht::RhtTraversal;
 use crate::rivals::slc_minmax::SlcDescent;
 
 /// What a knob's flag takes.
@@ -394,6 +395,37 @@ pub static KNOBS: &[Knob] = &[
         value: |o| o.reuse.rounds.to_string(),
         set: |o, s| {
             o.reuse.rounds = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "rht-tau",
+        help: "Resampled hierarchical tree: a node whose E&K variance measure ρ is below τ is split (both children gathered) with probability 1 − ρ/τ, in (0, 1].",
+        kind: KnobKind::Number,
+        value: |o| o.rht.tau.to_string(),
+        set: |o, s| {
+            o.rht.tau = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "rht-picks",
+        help: "Resampled hierarchical tree: candidates resampled (with replacement) per shading point, one shadow ray each.",
+        kind: KnobKind::Number,
+        value: |o| o.rht.picks.to_string(),
+        set: |o, s| {
+            o.rht.picks = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "rht-traversal",
+        help: "Resampled hierarchical tree: a candidate's gathering probability, `corrected` (the marginal probability, unbiased) or `biased` (a split node's factor left out, the published form's defect: darkens).",
+        kind: KnobKind::Choice(|| RhtTraversal::ALL.map(RhtTraversal::name).to_vec()),
+        value: |o| o.rht.traversal.name().to_string(),
+        set: |o, s| {
+            let names = RhtTraversal::ALL.map(RhtTraversal::name);
+            o.rht.traversal = choice(s, &names, RhtTraversal::from_name)?;
             Ok(())
         },
     },

@@ -77,6 +77,9 @@ pub struct StrategyOptions {
     pub slc_cut_size: usize,
     /// Stochastic lightcuts: how a cut node's light is drawn down its subtree.
     pub slc_descent: crate::rivals::slc_minmax::SlcDescent,
+    /// The resampled hierarchical tree: its split threshold, resampled picks and traversal
+    /// probability ([`crate::rivals::rht`]).
+    pub rht: crate::rivals::rht::RhtOptions,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
     pub learned: learned::LearnedConfig,
     /// The reuse strategies' parameters (`restir`, `restir-biased`).
@@ -150,6 +153,7 @@ impl Default for StrategyOptions {
             adaptive_split: true,
             slc_cut_size: DEFAULT_CUT_SIZE,
             slc_descent: Default::default(),
+            rht: Default::default(),
             learned: learned::LearnedConfig::default(),
             reuse: Default::default(),
         }

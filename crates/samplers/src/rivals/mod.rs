@@ -5,6 +5,10 @@
 //!   an error bound, one light per cut node drawn down its subtree, one shadow ray each.
 //! * [`slc_bo`]: `slc-bo+bsdf`, its descent weighed by the paper's BRDF-oriented importance.
 //! * [`slc_minmax`]: the descent of Lin & Yuksel's real-time code, as an option of `slc`.
+//! * [`rht`]: the resampled hierarchical tree (Conty Estevez, Hellmuth & Lecocq 2024): a
+//!   stochastic split traversal gathers candidates ([`rht_gather`]), one resampled to shade.
+pub mod rht;
+pub mod rht_gather;
 pub mod slc;
 pub mod slc_bo;
 pub mod slc_minmax;
