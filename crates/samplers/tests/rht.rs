@@ -99,7 +99,9 @@ fn each_light_is_gathered_with_its_probability_chi2_and_pi_replays() {
                 let gathered = strategy.gather(sp, &mut rng);
                 total += gathered.len();
                 for &(l, pi) in &gathered {
-                    assert_eq!(pi.to_bits(), strategy.inclusion(sp, l).0.to_bits());
+                    let (replayed, descent) = strategy.inclusion(sp, l);
+                    assert_eq!(pi.to_bits(), replayed.to_bits());
+                    assert_eq!(descent.to_bits(), strategy.descent_pmf(sp, l).to_bits());
                     counts[l as usize] += 1.0;
                 }
             }

@@ -287,6 +287,13 @@ impl Rht {
         out
     }
 
+    /// The single-descent pmf of `light` at `sp`, as the MIS weights take it.
+    pub fn descent_pmf(&self, sp: &ShadingPoint, light: u32) -> f32 {
+        let weights = self.weights(sp);
+        self.traversal(sp, &weights)
+            .map_or(0.0, |t| t.descent_pmf(light as usize))
+    }
+
     /// (π(`light`), single-descent pmf) at `sp` (zeros without lights).
     pub fn inclusion(&self, sp: &ShadingPoint, light: u32) -> (f32, f32) {
         let weights = self.weights(sp);
@@ -365,7 +372,7 @@ impl DirectLighting for Rht {
         weigh_candidates(scene, sp, rng, s);
         // P_D(ℓ)·p_pt(y): the light side's density in the MIS weights (module docs).
         let light_density =
-            |light: u32, pt_pdf: f32| traversal.inclusion(light as usize).1 * pt_pdf;
+            |light: u32, pt_pdf: f32| traversal.descent_pmf(light as usize) * pt_pdf;
         let picks = self.config.opts.picks;
         let mut l = Vec3::ZERO;
         for _ in 0..picks {

@@ -90,7 +90,9 @@ impl<W: Fn(NodeId) -> [f32; 2]> Traversal<'_, W> {
         let raw = (self.child_weights)(id);
         let w = [sanitize(raw[0]), sanitize(raw[1])];
         let split = if w[0] > 0.0 && w[1] > 0.0 && self.tau > 0.0 {
-            let rho = self.tree.split_metric(id, self.x, SplitCriterion::UnitFree);
+            // ρ = (1 + σ)^(−1/4), as `split_metric`, by two square roots instead of powf.
+            let sigma = self.tree.split_sigma(id, self.x, SplitCriterion::UnitFree);
+            let rho = (1.0 / (1.0 + sigma).sqrt().sqrt()) as f32;
             (1.0 - rho / self.tau).clamp(0.0, 1.0)
         } else {
             0.0
@@ -146,6 +148,32 @@ impl<W: Fn(NodeId) -> [f32; 2]> Traversal<'_, W> {
                 stack.push((child, prob * qc));
             }
         }
+    }
+
+    /// The pmf of `light` under a single descent by the same weights (Π p along its path, 0 at
+    /// a dead end): [`Traversal::inclusion`]'s second value without the split probabilities.
+    pub fn descent_pmf(&self, light: usize) -> f32 {
+        let tree = self.tree;
+        let leaf = tree.leaf_of(light);
+        let mut bits = tree.bit_trail(light);
+        let (mut id, mut pmf) = (tree.root(), 1.0f32);
+        while id != leaf {
+            let Some((l, r)) = tree.node(id).children(id) else {
+                return 0.0;
+            };
+            let raw = (self.child_weights)(id);
+            let w = [sanitize(raw[0]), sanitize(raw[1])];
+            let side = (bits & 1) as usize;
+            if w[side] == 0.0 {
+                return 0.0;
+            }
+            if w[1 - side] > 0.0 {
+                pmf *= w[side] / (w[0] + w[1]);
+            }
+            id = if side == 0 { l } else { r };
+            bits >>= 1;
+        }
+        pmf
     }
 
     /// (π(`light`), its pmf under a single descent by the same weights): the probability that
