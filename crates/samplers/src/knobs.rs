@@ -429,6 +429,36 @@ pub static KNOBS: &[Knob] = &[
             Ok(())
         },
     },
+    Knob {
+        flag: "varl-max-cut",
+        help: "Learning to cluster: most nodes in a region's cut (it starts from 8 and is refined between passes).",
+        kind: KnobKind::Number,
+        value: |o| o.varl.max_cut.to_string(),
+        set: |o, s| {
+            o.varl.max_cut = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "varl-cells",
+        help: "Learning to cluster: regions per scene diagonal (cell edge = diagonal / this), each with its own cut.",
+        kind: KnobKind::Number,
+        value: |o| o.varl.cells_per_diagonal.to_string(),
+        set: |o, s| {
+            o.varl.cells_per_diagonal = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
+        flag: "varl-defensive",
+        help: "Learning to cluster: share of the tree's importance alone in the pmf, in (0, 1].",
+        kind: KnobKind::Number,
+        value: |o| o.varl.defensive.to_string(),
+        set: |o, s| {
+            o.varl.defensive = number(s)?;
+            Ok(())
+        },
+    },
 ];
 
 #[cfg(test)]

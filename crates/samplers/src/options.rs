@@ -80,6 +80,8 @@ pub struct StrategyOptions {
     /// The resampled hierarchical tree: its split threshold, resampled picks and traversal
     /// probability ([`crate::rivals::rht`]).
     pub rht: crate::rivals::rht::RhtOptions,
+    /// Learning to cluster: the regions' cuts and the defensive share ([`crate::rivals::varl`]).
+    pub varl: crate::rivals::varl::VarlOptions,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
     pub learned: learned::LearnedConfig,
     /// The reuse strategies' parameters (`restir`, `restir-biased`).
@@ -154,6 +156,7 @@ impl Default for StrategyOptions {
             slc_cut_size: DEFAULT_CUT_SIZE,
             slc_descent: Default::default(),
             rht: Default::default(),
+            varl: Default::default(),
             learned: learned::LearnedConfig::default(),
             reuse: Default::default(),
         }

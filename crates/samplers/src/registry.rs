@@ -39,6 +39,8 @@ pub static STRATEGIES: &[&Strategy] = &[
     &rivals::rht::RHT,
     &rivals::rht::RHT_BSDF,
     &rivals::rht::RHT_BO_BSDF,
+    &rivals::varl::VARL,
+    &rivals::varl::VARL_BSDF,
     &crate::reuse::strategy::RESTIR,
     &crate::reuse::strategy::RESTIR_BIASED,
     &crate::reuse::strategy::RESTIR_BO,

@@ -7,8 +7,12 @@
 //! * [`slc_minmax`]: the descent of Lin & Yuksel's real-time code, as an option of `slc`.
 //! * [`rht`]: the resampled hierarchical tree (Conty Estevez, Hellmuth & Lecocq 2024): a
 //!   stochastic split traversal gathers candidates ([`rht_gather`]), one resampled to shade.
+//! * [`varl`]: learning to cluster (Wang, Wu, Li & Chuang 2021): per region a cut refined and a
+//!   distribution over it learnt between passes ([`varl_table`]).
 pub mod rht;
 pub mod rht_gather;
 pub mod slc;
 pub mod slc_bo;
 pub mod slc_minmax;
+pub mod varl;
+pub mod varl_table;
