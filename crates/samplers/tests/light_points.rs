@@ -20,7 +20,14 @@ fn every_strategy_converges_under_every_point_sampler() {
     for points in [LightPoints::SolidAngle, LightPoints::SolidAngleWarp] {
         let mut scene = common::mixed_scene(20);
         scene.light_points = points;
-        for (name, spp) in [("power+bsdf", 64), ("tree+bsdf", 64), ("mis3-adaptive", 16)] {
+        for (name, spp) in [
+            ("power+bsdf", 64),
+            ("tree+bsdf", 64),
+            ("mis3-adaptive", 16),
+            ("slc+bsdf", 16),
+            ("rht+bsdf", 64),
+            ("varl+bsdf", 64),
+        ] {
             let r = render(&scene, name, spp, 2);
             let failures = compare(&reference, &r, 2, 3.0);
             assert!(

@@ -312,7 +312,7 @@ fn weigh_candidates(scene: &Scene, sp: &ShadingPoint, rng: &mut SampleStream, s:
     } = s;
     for &(light, pi) in gathered.iter() {
         let u = rng.next_2d();
-        let Some(sample) = scene.sample_light(light, sp.point(), u) else {
+        let Some(sample) = scene.sample_light(light, sp.point(), sp.normal(), u) else {
             continue;
         };
         let target = luminance(sp.bsdf.eval_cos(sp.wo, sample.wi) * sample.radiance);
@@ -397,7 +397,7 @@ impl DirectLighting for Rht {
             if let Some(b) = sample_bsdf(scene, sp, rng, ctx.counters)
                 && b.found_light()
             {
-                let pt = scene.lights[b.light as usize].pdf(sp.point(), b.point, b.normal);
+                let pt = scene.light_pdf(b.light, sp.point(), sp.normal(), b.point, b.normal);
                 let p_light = light_density(b.light, pt);
                 l += b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf);
             }
