@@ -2,13 +2,109 @@
 //! drawn (`--light-points`), and the strategies' MIS weighs a BSDF-sampled hit by the density
 //! the chosen point sampler gives it.
 mod common;
+use glam::Mat4;
+use render_core::Vec3;
+use render_core::camera::Camera;
 use render_core::light_points::LightPoints;
-use render_core::scene::Scene;
+use render_core::material::Material;
+use render_core::scene::{Scene, SceneBuilder};
 use samplers::StrategyOptions;
 use samplers::convergence::compare;
 
 fn render(scene: &Scene, name: &str, spp: u32, seed: u64) -> render_core::render::RenderResult {
     common::render_opts(scene, name, &StrategyOptions::default(), spp, 2, seed, None)
+}
+
+/// Where the point samplers differ most: a large square light 0.5 above a glossy metal floor
+/// (z = 0) and close to a rough metal wall, seen from above at an angle. The mixed scene's small
+/// lights alone would not catch a wrong density (its samplers nearly agree there).
+fn panel(points: LightPoints) -> Scene {
+    let mut b = SceneBuilder::new("panel");
+    let metal = |b: &mut SceneBuilder, name: &str, roughness: f32| {
+        b.add_material(Material::simple(
+            name,
+            Vec3::new(0.9, 0.8, 0.6),
+            1.0,
+            roughness,
+        ))
+        .unwrap()
+    };
+    let (floor, wall) = (metal(&mut b, "floor", 0.15), metal(&mut b, "wall", 0.3));
+    let quad = |b: &mut SceneBuilder, p: [Vec3; 4], m: u32| {
+        b.add_mesh(
+            "quad",
+            &p,
+            None,
+            None,
+            &[0, 1, 2, 0, 2, 3],
+            Mat4::IDENTITY,
+            m,
+        )
+        .unwrap();
+    };
+    let v = Vec3::new;
+    quad(
+        &mut b,
+        [
+            v(-3., -3., 0.),
+            v(3., -3., 0.),
+            v(3., 3., 0.),
+            v(-3., 3., 0.),
+        ],
+        floor,
+    );
+    quad(
+        &mut b,
+        [
+            v(-3., 1.2, 0.),
+            v(3., 1.2, 0.),
+            v(3., 1.2, 2.),
+            v(-3., 1.2, 2.),
+        ],
+        wall,
+    );
+    common::ceiling_square(&mut b, 1.6, 0.5, 3.0);
+    b.add_camera(Camera::look_at(
+        "cam",
+        v(0.0, -2.2, 1.6),
+        v(0.0, 0.2, 0.0),
+        Vec3::Z,
+        50f32.to_radians(),
+        40,
+        30,
+    ));
+    let mut scene = b.build().unwrap();
+    scene.light_points = points;
+    scene
+}
+
+/// Every point sampler, and the method's BRDF-aware points, converge to area sampling's image
+/// of the panel.
+#[test]
+fn point_samplers_agree_on_a_large_close_light() {
+    let reference = render(&panel(LightPoints::Area), "power+bsdf", 1024, 1);
+    let ltc = StrategyOptions {
+        ltc_triangles: true,
+        ..StrategyOptions::default()
+    };
+    for points in [LightPoints::SolidAngle, LightPoints::SolidAngleWarp] {
+        let scene = panel(points);
+        for (name, opts, spp) in [
+            ("power+bsdf", StrategyOptions::default(), 256),
+            ("mis3-adaptive", StrategyOptions::default(), 32),
+            ("mis3-adaptive", ltc.clone(), 32),
+        ] {
+            let r = common::render_opts(&scene, name, &opts, spp, 2, 5, None);
+            let failures = compare(&reference, &r, 4, 3.0);
+            assert!(
+                failures.is_empty(),
+                "{name} (ltc {}) under {}:\n{}",
+                opts.ltc_triangles,
+                points.name(),
+                failures.join("\n")
+            );
+        }
+    }
 }
 
 /// The mixed scene: glossy, metal and diffuse surfaces lit by two quads of triangle lights
