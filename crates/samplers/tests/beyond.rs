@@ -182,7 +182,7 @@ fn ris_candidate_sources_match_their_pmfs_chi2_and_replay() {
     let close = |a: f32, b: f32| (a - b).abs() <= 1e-4 * a.abs().max(b.abs());
     let mut with_bo = 0;
     for (k, sp) in shading_points(&scene).iter().enumerate() {
-        let bo = ris.bo_state(sp);
+        let bo = ris.bo_state(&scene, sp);
         with_bo += bo.is_some() as usize;
         let source = CandidateSource::new(&scene, tree, sp, bo.as_ref(), 8);
         assert_eq!(source.count(), 8);
@@ -272,6 +272,6 @@ fn adaptive_candidate_count_follows_the_bo_upper_bound() {
     let scene = common::mixed_scene(40);
     let ris = ris_strategy(&scene);
     let sp = shading_points(&scene)[0];
-    let ub = ris.bo_state(&sp).unwrap().cut().upper_bound();
+    let ub = ris.bo_state(&scene, &sp).unwrap().cut().upper_bound();
     assert!(ub > 0.0 && ub <= 1.0);
 }
