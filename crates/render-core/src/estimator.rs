@@ -1,82 +1,14 @@
 //! The interface between the render loop and light-sampling strategies.
-use crate::bsdf::Bsdf;
-use crate::light::LightSample;
 use crate::pilot::Pilot;
 use crate::rng::SampleStream;
-use crate::scene::{Scene, SurfaceHit, offset_origin};
+use crate::scene::Scene;
 use crate::stats::Counters;
 use glam::Vec3;
 
-/// Most per-pixel diagnostic channels a strategy can write.
-pub const MAX_AUX: usize = 4;
+pub use crate::shading_point::ShadingPoint;
+pub use crate::stats::MAX_AUX;
 /// Floats of per-pixel memory a strategy may keep across passes of the same pixel.
 pub const PIXEL_MEMORY: usize = 16;
-
-/// A camera-ray hit on a reflecting surface, ready for direct lighting.
-#[derive(Clone, Copy, Debug)]
-pub struct ShadingPoint {
-    pub hit: SurfaceHit,
-    /// Unit direction towards the viewer.
-    pub wo: Vec3,
-    pub bsdf: Bsdf,
-}
-
-impl ShadingPoint {
-    pub fn point(&self) -> Vec3 {
-        self.hit.point
-    }
-
-    /// The shading normal on the viewer's side: the receiver's normal of light sampling.
-    pub fn normal(&self) -> Vec3 {
-        self.bsdf.frame.z
-    }
-
-    /// Ray origin for a ray leaving in direction `w`.
-    pub fn origin_towards(&self, w: Vec3) -> Vec3 {
-        offset_origin(self.hit.point, self.hit.ng, w)
-    }
-
-    /// Unoccluded contribution f·cos·L of a light sample, before dividing by any pdf; traces the
-    /// shadow ray only when the unshadowed value is non-zero.
-    pub fn shade(&self, scene: &Scene, s: &LightSample, counters: &mut Counters) -> Vec3 {
-        let f = self.bsdf.eval_cos(self.wo, s.wi) * s.radiance;
-        self.unless_occluded(scene, s, f, counters)
-    }
-
-    /// [`ShadingPoint::shade`] and the BSDF's sampling density of the light sample's direction
-    /// (for its MIS weight), both from one BSDF evaluation.
-    pub fn shade_with_pdf(
-        &self,
-        scene: &Scene,
-        s: &LightSample,
-        counters: &mut Counters,
-    ) -> (Vec3, f32) {
-        let v = self.bsdf.eval(self.wo, s.wi);
-        let f = self.unless_occluded(scene, s, v.f_cos * s.radiance, counters);
-        (f, v.pdf)
-    }
-
-    /// `f`, or zero when it is zero or the light sample's shadow ray is blocked.
-    #[inline]
-    fn unless_occluded(
-        &self,
-        scene: &Scene,
-        s: &LightSample,
-        f: Vec3,
-        counters: &mut Counters,
-    ) -> Vec3 {
-        if f == Vec3::ZERO {
-            return Vec3::ZERO;
-        }
-        counters.shadow_rays += 1;
-        let o = self.origin_towards(s.wi);
-        if scene.occluded(o, s.wi, (s.point - o).length()) {
-            Vec3::ZERO
-        } else {
-            f
-        }
-    }
-}
 
 /// What a strategy may write besides its radiance estimate.
 pub struct SampleContext<'a> {

@@ -14,10 +14,11 @@
 //! left, so the budget is missed by at most half a pass either way), a strategy's per-pixel
 //! memory and pilot are not offered, and the passes' pixels are no longer independent (a
 //! pixel's estimate uses its neighbours' samples of the same pass; passes stay independent).
-use crate::estimator::{MAX_AUX, ShadingPoint};
 use crate::rng::SampleStream;
 use crate::scene::Scene;
+use crate::shading_point::ShadingPoint;
 use crate::stats::Counters;
+use crate::stats::MAX_AUX;
 use glam::Vec3;
 use rayon::prelude::*;
 use std::sync::Mutex;

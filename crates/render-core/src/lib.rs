@@ -30,6 +30,7 @@ pub mod sampling;
 pub mod scene;
 pub mod scene_hash;
 pub mod scene_hints;
+pub mod shading_point;
 pub mod spherical_triangle;
 pub mod splat;
 pub mod stats;

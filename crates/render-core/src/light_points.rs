@@ -9,7 +9,6 @@
 //! thresholds. The same fallback runs in [`LightPoints::pdf`], from the same numbers, so a
 //! point's density is the one it was sampled with.
 use crate::light::{Light, LightSample, LightShape, TrianglePoint};
-use crate::scene::Scene;
 use crate::spherical_triangle::{SphericalTriangle, bilinear_pdf, bilinear_sample};
 use glam::{DVec3, Vec2, Vec3};
 
@@ -118,34 +117,6 @@ impl LightPoints {
         let warp =
             (self == LightPoints::SolidAngleWarp && n != Vec3::ZERO).then(|| st.cosine_weights(n));
         Some((st, warp))
-    }
-}
-
-impl Scene {
-    /// A point on light `light` for a receiver at `x` with unit normal `n` (zero if none), by
-    /// the scene's [`LightPoints`]; under `area` through the light's one-cache-line record when
-    /// it is a plain triangle (the same result as [`Light::sample`], bit for bit).
-    #[inline]
-    pub fn sample_light(&self, light: u32, x: Vec3, n: Vec3, u: Vec2) -> Option<LightSample> {
-        if self.light_points != LightPoints::Area {
-            return self
-                .light_points
-                .sample(&self.lights[light as usize], x, n, u);
-        }
-        let rec = &self.triangle_records[light as usize];
-        if rec.is_plain_triangle() {
-            rec.sample(x, u)
-        } else {
-            self.lights[light as usize].sample(x, u)
-        }
-    }
-
-    /// The solid-angle density with which [`Scene::sample_light`] draws `point` (normal
-    /// `normal`) of light `light`, for MIS.
-    #[inline]
-    pub fn light_pdf(&self, light: u32, x: Vec3, n: Vec3, point: Vec3, normal: Vec3) -> f32 {
-        self.light_points
-            .pdf(&self.lights[light as usize], x, n, point, normal)
     }
 }
 

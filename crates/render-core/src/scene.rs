@@ -3,7 +3,7 @@
 use crate::accel::{Accel, Primitive};
 use crate::camera::Camera;
 use crate::error::SceneError;
-use crate::light::{DistantLight, Light, LightShape, SpotCone, TriangleRecord};
+use crate::light::{DistantLight, Light, LightSample, LightShape, SpotCone, TriangleRecord};
 use crate::material::Material;
 use glam::{Mat4, Vec2, Vec3};
 use serde::Serialize;
@@ -584,5 +584,33 @@ impl SceneBuilder {
             accel,
             light_points: Default::default(),
         })
+    }
+}
+
+impl Scene {
+    /// A point on light `light` for a receiver at `x` with unit normal `n` (zero if none), by
+    /// the scene's [`crate::light_points::LightPoints`]; under `area` through the light's one-cache-line record when
+    /// it is a plain triangle (the same result as [`Light::sample`], bit for bit).
+    #[inline]
+    pub fn sample_light(&self, light: u32, x: Vec3, n: Vec3, u: Vec2) -> Option<LightSample> {
+        if self.light_points != crate::light_points::LightPoints::Area {
+            return self
+                .light_points
+                .sample(&self.lights[light as usize], x, n, u);
+        }
+        let rec = &self.triangle_records[light as usize];
+        if rec.is_plain_triangle() {
+            rec.sample(x, u)
+        } else {
+            self.lights[light as usize].sample(x, u)
+        }
+    }
+
+    /// The solid-angle density with which [`Scene::sample_light`] draws `point` (normal
+    /// `normal`) of light `light`, for MIS.
+    #[inline]
+    pub fn light_pdf(&self, light: u32, x: Vec3, n: Vec3, point: Vec3, normal: Vec3) -> f32 {
+        self.light_points
+            .pdf(&self.lights[light as usize], x, n, point, normal)
     }
 }

@@ -1,6 +1,9 @@
 //! Counters of work done, gathered per thread and merged.
 use serde::Serialize;
 
+/// Most per-pixel diagnostic channels a strategy can write.
+pub const MAX_AUX: usize = 4;
+
 /// Most techniques a strategy can report sample counts for.
 pub const MAX_TECHNIQUES: usize = 8;
 /// Most counters of its own a strategy can declare.

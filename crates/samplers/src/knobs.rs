@@ -5,7 +5,7 @@ use crate::StrategyOptions;
 use crate::brdf_oriented::{BoImportance, BrdfIntegral};
 use crate::learned::{LearnTarget, PassWeights};
 use crate::reuse::config::CandidateSourceKind;
-use crate::rivals::rht::RhtTraversal;
+use crate::rivals::rht_options::RhtTraversal;
 use crate::rivals::slc_minmax::SlcDescent;
 
 /// What a knob's flag takes.

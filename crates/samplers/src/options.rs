@@ -79,9 +79,9 @@ pub struct StrategyOptions {
     pub slc_descent: crate::rivals::slc_minmax::SlcDescent,
     /// The resampled hierarchical tree: its split threshold, resampled picks and traversal
     /// probability ([`crate::rivals::rht`]).
-    pub rht: crate::rivals::rht::RhtOptions,
+    pub rht: crate::rivals::rht_options::RhtOptions,
     /// Learning to cluster: the regions' cuts and the defensive share ([`crate::rivals::varl`]).
-    pub varl: crate::rivals::varl::VarlOptions,
+    pub varl: crate::rivals::varl_options::VarlOptions,
     /// The learned selection's parameters (`learned`, `learned+bsdf`, `mis3-adaptive-learned`).
     pub learned: learned::LearnedConfig,
     /// The reuse strategies' parameters (`restir`, `restir-biased`).

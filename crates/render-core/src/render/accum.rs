@@ -1,7 +1,5 @@
 //! What a render keeps per pixel while it runs, and whether the machine can hold it.
-use super::unit::PixelSample;
-use crate::estimator::{MAX_AUX, PIXEL_MEMORY, ShadingPoint};
-use crate::rng::SampleStream;
+use crate::estimator::{MAX_AUX, PIXEL_MEMORY};
 use glam::Vec3;
 
 /// A pixel's running sums over its samples so far.
@@ -26,16 +24,6 @@ pub fn memory_estimate(width: u32, height: u32, aux_channels: usize) -> u64 {
     let finished = 3 * size_of::<Vec3>() + size_of::<f32>() * (1 + aux_channels);
     let per_pixel = size_of::<PixelAccum>() + finished;
     width as u64 * height as u64 * per_pixel as u64
-}
-
-/// Bytes per pixel an image-space pass adds (`crate::image_space`): the shading points, sample
-/// streams and camera samples of the pass, its result, and `strategy_bytes` of the strategy's own.
-pub(super) fn image_pass_bytes(strategy_bytes: usize) -> usize {
-    size_of::<Option<ShadingPoint>>()
-        + size_of::<SampleStream>()
-        + size_of::<PixelSample>()
-        + size_of::<(Vec3, [f32; MAX_AUX])>()
-        + strategy_bytes
 }
 
 /// Refuses, before anything is allocated, a render that needs more memory than the machine

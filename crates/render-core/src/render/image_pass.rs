@@ -5,11 +5,22 @@ use super::pass_job::PassJob;
 use super::passes::Passes;
 use super::shading::{camera_hit, distant_lighting};
 use super::unit::PixelSample;
-use crate::estimator::MAX_AUX;
+use crate::estimator::{MAX_AUX, ShadingPoint};
 use crate::image_space::{ImagePass, ImageSpaceLighting, par_pixels};
+use crate::rng::SampleStream;
 use crate::stats::Counters;
 use glam::Vec3;
 use std::sync::Mutex;
+
+/// Bytes per pixel an image-space pass adds (`crate::image_space`): the shading points, sample
+/// streams and camera samples of the pass, its result, and `strategy_bytes` of the strategy's own.
+pub(super) fn image_pass_bytes(strategy_bytes: usize) -> usize {
+    size_of::<Option<ShadingPoint>>()
+        + size_of::<SampleStream>()
+        + size_of::<PixelSample>()
+        + size_of::<(Vec3, [f32; MAX_AUX])>()
+        + strategy_bytes
+}
 
 impl Passes {
     /// Pass `sample_index` of every pixel through `strategy`'s image-space form.

@@ -60,7 +60,7 @@ pub fn render(
         settings.width,
         settings.height,
         strategy.aux_channels().len(),
-        image_space.map_or(0, |s| accum::image_pass_bytes(s.bytes_per_pixel())),
+        image_space.map_or(0, |s| image_pass::image_pass_bytes(s.bytes_per_pixel())),
     )?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(settings.threads.unwrap_or(0))

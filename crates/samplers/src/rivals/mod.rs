@@ -9,10 +9,14 @@
 //!   stochastic split traversal gathers candidates ([`rht_gather`]), one resampled to shade.
 //! * [`varl`]: learning to cluster (Wang, Wu, Li & Chuang 2021): per region a cut refined and a
 //!   distribution over it learnt between passes ([`varl_table`]).
+//!
+//! Their knobs live apart ([`rht_options`], [`varl_options`]), as leaves the shared options import.
 pub mod rht;
 pub mod rht_gather;
+pub mod rht_options;
 pub mod slc;
 pub mod slc_bo;
 pub mod slc_minmax;
 pub mod varl;
+pub mod varl_options;
 pub mod varl_table;

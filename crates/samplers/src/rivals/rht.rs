@@ -42,8 +42,8 @@
 //! sampling cannot hit). w_R is a fixed function of y and the shading point, so w_R·f is a
 //! valid RIS integrand; where P_D > 0 every step on ℓ's path has q ≥ p > 0, so π > 0 and the
 //! candidates cover every y with w_R(y) > 0; elsewhere w_R = 0 and BSDF sampling takes it all.
-pub use super::rht_gather::RhtTraversal;
 use super::rht_gather::Traversal;
+pub use super::rht_options::{DEFAULT_PICKS, DEFAULT_TAU, MAX_PICKS, RhtOptions, RhtTraversal};
 use super::slc_bo::BoWeight;
 use crate::bsdf_sampling::sample_bsdf;
 use crate::mis::power2;
@@ -59,14 +59,6 @@ use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
 use render_core::light::LightSample;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
-use serde::{Deserialize, Serialize};
-
-/// τ of the split probability.
-pub const DEFAULT_TAU: f32 = 0.85;
-/// Candidates resampled per shading point.
-pub const DEFAULT_PICKS: u32 = 1;
-/// The most picks accepted.
-pub const MAX_PICKS: u32 = 1024;
 
 /// Index of the gathered candidates in the technique counters.
 pub const TECHNIQUE_CANDIDATES: usize = 0;
@@ -74,44 +66,6 @@ pub const TECHNIQUE_CANDIDATES: usize = 0;
 pub const TECHNIQUE_RHT: usize = 1;
 /// Index of BSDF sampling.
 pub const TECHNIQUE_BSDF: usize = 2;
-
-/// The knobs of the RHT strategies.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(default)]
-pub struct RhtOptions {
-    /// τ of the split probability, in (0, 1].
-    pub tau: f32,
-    /// Candidates resampled per shading point (R), one shadow ray each.
-    pub picks: u32,
-    /// How the gathering probability is accumulated.
-    pub traversal: RhtTraversal,
-}
-
-impl Default for RhtOptions {
-    fn default() -> Self {
-        RhtOptions {
-            tau: DEFAULT_TAU,
-            picks: DEFAULT_PICKS,
-            traversal: RhtTraversal::Corrected,
-        }
-    }
-}
-
-impl RhtOptions {
-    /// An error for τ outside (0, 1] or R outside 1..=[`MAX_PICKS`].
-    pub fn check(&self) -> Result<(), String> {
-        if !(self.tau > 0.0 && self.tau <= 1.0) {
-            return Err(format!("rht: τ must be in (0, 1], got {}", self.tau));
-        }
-        if !(1..=MAX_PICKS).contains(&self.picks) {
-            return Err(format!(
-                "rht: the picks must be in 1..={MAX_PICKS}, got {}",
-                self.picks
-            ));
-        }
-        Ok(())
-    }
-}
 
 /// What an RHT strategy is built with.
 #[derive(Clone, Copy, Debug, PartialEq)]

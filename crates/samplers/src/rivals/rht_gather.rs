@@ -28,36 +28,8 @@
 //! kept to show the bias in a test (`tests/rht.rs`), not to be used.
 use light_tree::{LightTree, NodeId, SplitCriterion};
 use render_core::rng::SampleStream;
-use serde::{Deserialize, Serialize};
 
-/// How a candidate's gathering probability is accumulated down the tree.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum RhtTraversal {
-    /// The marginal probability of visiting each node on the path (unbiased; our default).
-    #[default]
-    Corrected,
-    /// A split node's factor left out (the published form's defect; biased dark).
-    Biased,
-}
-
-impl RhtTraversal {
-    /// Every form, in `--rht-traversal`'s order.
-    pub const ALL: [RhtTraversal; 2] = [RhtTraversal::Corrected, RhtTraversal::Biased];
-
-    /// The name `--rht-traversal` takes.
-    pub fn name(self) -> &'static str {
-        match self {
-            RhtTraversal::Corrected => "corrected",
-            RhtTraversal::Biased => "biased",
-        }
-    }
-
-    /// The form called `name`.
-    pub fn from_name(name: &str) -> Option<RhtTraversal> {
-        RhtTraversal::ALL.into_iter().find(|d| d.name() == name)
-    }
-}
+pub use super::rht_options::RhtTraversal;
 
 /// A weight of 0 for anything not positive, finite weights kept below overflow (as the
 /// tree's own descent sanitises them, so that replays agree).
