@@ -45,6 +45,7 @@ use host::process_cpu_seconds;
 use pass_job::PassJob;
 use passes::Passes;
 use settings::BudgetClockReader;
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
 /// Renders `scene` with `strategy`. `progress` is called after each pass with (passes done, full passes so far).
@@ -53,6 +54,22 @@ pub fn render(
     strategy: &dyn DirectLighting,
     settings: &RenderSettings,
     progress: &(dyn Fn(u32, u32) + Sync),
+) -> Result<RenderResult, String> {
+    render_cancellable(scene, strategy, settings, progress, &AtomicBool::new(false))
+}
+
+/// The error of a render stopped by its `cancel` flag.
+pub const CANCELLED: &str = "the render was cancelled";
+
+/// [`render`] that another thread can stop by setting `cancel` (an interactive host's Ctrl-C):
+/// the worker threads stop claiming work units and the render returns [`CANCELLED`] within one
+/// unit per thread. Until it is set, the image is [`render`]'s, bit for bit.
+pub fn render_cancellable(
+    scene: &Scene,
+    strategy: &dyn DirectLighting,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u32, u32) + Sync),
+    cancel: &AtomicBool,
 ) -> Result<RenderResult, String> {
     settings.check()?;
     let image_space = strategy.image_space();
@@ -93,7 +110,16 @@ pub fn render(
         counters.merge(&c);
         pilot_samples = n;
     }
-    passes.run(&job, &pool, clock.as_ref(), &mut counters, progress)?;
+    if cancel.load(Ordering::Relaxed) {
+        return Err(CANCELLED.into());
+    }
+    passes.run(
+        &job,
+        &pool,
+        clock.as_ref(),
+        &mut counters,
+        (progress, cancel),
+    )?;
     let run = RunInfo {
         start,
         cpu_start,

@@ -50,14 +50,15 @@ impl Passes {
     }
 
     /// Runs passes until the sample count is reached or the budget stops one inside; calls
-    /// `progress` after each with (passes done, full passes so far).
+    /// `progress` after each with (passes done, full passes so far). A set `cancel` ends it
+    /// with [`super::CANCELLED`].
     pub(super) fn run(
         &mut self,
         job: &PassJob,
         pool: &rayon::ThreadPool,
         clock: Option<&BudgetClockReader>,
         counters: &mut Counters,
-        progress: &(dyn Fn(u32, u32) + Sync),
+        (progress, cancel): (&(dyn Fn(u32, u32) + Sync), &AtomicBool),
     ) -> Result<(), String> {
         let stop = AtomicBool::new(false);
         let image_space = job.strategy.image_space();
@@ -94,8 +95,11 @@ impl Passes {
                     let n_units = job.grid.len().div_ceil(UNIT_PIXELS);
                     (n_units, n_units)
                 }
-                None => self.pass(job, pool, (clock, &stop), pass_weight, counters),
+                None => self.pass(job, pool, (clock, &stop, cancel), pass_weight, counters),
             };
+            if cancel.load(Ordering::Relaxed) {
+                return Err(super::CANCELLED.into());
+            }
             if done == 0 {
                 break;
             }
@@ -124,7 +128,7 @@ impl Passes {
         &mut self,
         job: &PassJob,
         pool: &rayon::ThreadPool,
-        (clock, stop): (Option<&BudgetClockReader>, &AtomicBool),
+        (clock, stop, cancel): (Option<&BudgetClockReader>, &AtomicBool, &AtomicBool),
         pass_weight: f64,
         counters: &mut Counters,
     ) -> (usize, usize) {
@@ -139,7 +143,7 @@ impl Passes {
             .collect();
         let next_unit = AtomicUsize::new(0);
         let pass_counters: Vec<Counters> =
-            pool.broadcast(|_| claim_units(job, &units, &next_unit, (clock, stop), sample));
+            pool.broadcast(|_| claim_units(job, &units, &next_unit, (clock, stop, cancel), sample));
         for c in &pass_counters {
             counters.merge(c);
         }
@@ -156,17 +160,20 @@ impl Passes {
 }
 
 /// One worker thread's share of a pass: units claimed in order until none is left or the
-/// budget is spent; returns what it counted.
+/// budget is spent or the render cancelled; returns what it counted.
 fn claim_units(
     job: &PassJob,
     units: &Units,
     next_unit: &AtomicUsize,
-    (clock, stop): (Option<&BudgetClockReader>, &AtomicBool),
+    (clock, stop, cancel): (Option<&BudgetClockReader>, &AtomicBool, &AtomicBool),
     sample: (u64, f64),
 ) -> Counters {
     let mut c = Counters::default();
     let mut last_cpu_read = None;
     loop {
+        if cancel.load(Ordering::Relaxed) {
+            break;
+        }
         if let Some(clock) = clock
             && (stop.load(Ordering::Relaxed) || clock.spent(&mut last_cpu_read))
         {

@@ -473,3 +473,38 @@ fn emission_rays_with_splatting_are_refused() {
         .expect("refused");
     assert!(e.contains("sampled reconstruction"), "{e}");
 }
+
+/// A cancel flag set before the render, or by the progress callback after its second pass,
+/// ends it with `CANCELLED` instead of an image; an unset one changes nothing.
+#[test]
+fn a_cancelled_render_returns_the_cancelled_error() {
+    let scene = test_scene();
+    let s = settings(&scene, Some(50), None, 2, Sampler::Independent);
+    let set = AtomicBool::new(true);
+    let r = render_cancellable(&scene, &OneLight, &s, &|_, _| {}, &set);
+    assert_eq!(r.err().as_deref(), Some(CANCELLED));
+    let cancel = AtomicBool::new(false);
+    let passes_seen = std::sync::atomic::AtomicU32::new(0);
+    let r = render_cancellable(
+        &scene,
+        &OneLight,
+        &s,
+        &|passes, _| {
+            passes_seen.store(passes, Ordering::Relaxed);
+            if passes == 2 {
+                cancel.store(true, Ordering::Relaxed);
+            }
+        },
+        &cancel,
+    );
+    assert_eq!(r.err().as_deref(), Some(CANCELLED));
+    assert_eq!(
+        passes_seen.load(Ordering::Relaxed),
+        2,
+        "no pass after the flag"
+    );
+    let unset = AtomicBool::new(false);
+    let s3 = settings(&scene, Some(3), None, 2, Sampler::Independent);
+    let a = render_cancellable(&scene, &OneLight, &s3, &|_, _| {}, &unset).unwrap();
+    assert_eq!(a.pixels, run(&scene, Some(3), None, 1).pixels);
+}
