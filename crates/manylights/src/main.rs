@@ -1,7 +1,6 @@
 //! `manylights`: render, inspect and list scenes and strategies.
-mod render_cmd;
-
 use clap::{Parser, Subcommand};
+use manylights::render_cmd;
 use std::process::ExitCode;
 
 #[derive(Parser)]
@@ -118,30 +117,16 @@ fn main() -> ExitCode {
 }
 
 fn list_strategies(json: bool) -> anyhow::Result<()> {
-    let defaults = samplers::StrategyOptions::default();
     if !json {
         for s in samplers::strategies() {
             println!("{:<22} {}", s.name, s.description);
         }
         return Ok(());
     }
-    let list: Vec<serde_json::Value> = samplers::strategies()
-        .iter()
-        .map(|s| {
-            let knobs: Vec<serde_json::Value> = s
-                .all_knobs()
-                .filter_map(samplers::knobs::knob)
-                .map(|k| serde_json::json!({ "flag": format!("--{}", k.flag), "default": k.default_value(), "help": k.help }))
-                .collect();
-            serde_json::json!({
-                "name": s.name,
-                "description": s.description,
-                "knobs": knobs,
-                "emission_rays": s.default_emission_rays(&defaults),
-            })
-        })
-        .collect();
-    println!("{}", serde_json::to_string_pretty(&list)?);
+    println!(
+        "{}",
+        serde_json::to_string_pretty(&manylights::strategies_json())?
+    );
     Ok(())
 }
 
@@ -175,7 +160,7 @@ fn info(spec: &str, json: bool) -> anyhow::Result<()> {
     let scene = scene_formats::load_scene(spec, None)?;
     let s = &scene.stats;
     if json {
-        let v = serde_json::json!({ "scene": spec, "scene_hash": scene.content_hash(), "stats": s, "bounds": [scene.bounds.0.to_array(), scene.bounds.1.to_array()], "cameras": scene.cameras.iter().map(|c| &c.name).collect::<Vec<_>>() });
+        let v = manylights::scene_info_json(spec, &scene);
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }

@@ -246,8 +246,8 @@ struct Choices {
     reconstruction: (Reconstruction, &'static str),
 }
 
-/// The flags' own checks, before anything is loaded.
-fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
+/// The flags' own checks, before anything is loaded (the outputs apart: [`check_outputs`]).
+pub fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
     if args.spp == Some(0) {
         bail!("--spp must be at least 1");
     }
@@ -262,6 +262,11 @@ fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
     if args.exposure.is_some_and(|e| !e.is_finite()) {
         bail!("--exposure must be a finite number of stops");
     }
+    Ok(())
+}
+
+/// That the output files can be written, before a long render.
+fn check_outputs(args: &RenderArgs) -> anyhow::Result<()> {
     check_writable(&args.out)?;
     if let Some(p) = &args.png {
         check_writable(p)?;
@@ -374,8 +379,77 @@ fn render_with_progress(
     Ok(result)
 }
 
+/// `render`'s flags from `argv` (without the program and command names), parsed as the command
+/// line parses them; an error is clap's message, its first line without `error: `.
+pub fn parse_args(argv: &[String]) -> Result<RenderArgs, String> {
+    use clap::{Args, FromArgMatches};
+    let cmd = RenderArgs::augment_args(clap::Command::new("render").no_binary_name(true));
+    cmd.try_get_matches_from(argv)
+        .and_then(|m| RenderArgs::from_arg_matches(&m))
+        .map_err(|e| {
+            let text = e.render().to_string();
+            let line = text.lines().next().unwrap_or_default();
+            line.strip_prefix("error: ").unwrap_or(line).to_string()
+        })
+}
+
+/// A render ready to run: the strategy built for the scene, the settings and what chose them.
+pub struct Prepared {
+    pub strategy: Box<dyn DirectLighting>,
+    pub settings: RenderSettings,
+    choices: Choices,
+    resolved: serde_json::Value,
+}
+
+/// The strategy and the settings the flags ask for on `scene` (loaded from `args.scene` with
+/// `args.camera`), or the error the command line gives.
+pub fn prepare(args: &RenderArgs, scene: &Scene) -> anyhow::Result<Prepared> {
+    let opts = args.strategy.options()?;
+    let emission_rays = args.strategy.emission_rays()?;
+    let resolved = args.strategy.resolved()?;
+    let choices = choose(args, scene, opts.reproduce);
+    let strategy = samplers::create(&args.strategy.strategy, scene, &opts)?;
+    let settings = settings(
+        args,
+        scene,
+        &choices,
+        emission_rays,
+        strategy.aux_channels().len(),
+    )?;
+    Ok(Prepared {
+        strategy,
+        settings,
+        choices,
+        resolved,
+    })
+}
+
+impl Prepared {
+    /// The render's JSON record, as `render` writes it when it writes no file besides the EXR.
+    pub fn metadata(
+        &self,
+        args: &RenderArgs,
+        scene: &Scene,
+        result: &RenderResult,
+    ) -> serde_json::Value {
+        let written = report::Written::nothing();
+        let p = self;
+        report::metadata(
+            args,
+            scene,
+            p.strategy.as_ref(),
+            &p.settings,
+            &p.choices,
+            result,
+            p.resolved.clone(),
+            &written,
+        )
+    }
+}
+
 pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     check_args(&args)?;
+    check_outputs(&args)?;
     let mut scene = scene_formats::load_scene(&args.scene, args.camera.as_deref())?;
     scene.light_points = args.strategy.light_points;
     if !args.quiet {
@@ -383,21 +457,16 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("warning: {w}");
         }
     }
-    let opts = args.strategy.options()?;
-    let emission_rays = args.strategy.emission_rays()?;
-    let resolved = args.strategy.resolved()?;
-    let choices = choose(&args, &scene, opts.reproduce);
-    let strategy = samplers::create(&args.strategy.strategy, &scene, &opts)?;
+    let prepared = prepare(&args, &scene)?;
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
     }
-    let settings = settings(
-        &args,
-        &scene,
-        &choices,
-        emission_rays,
-        strategy.aux_channels().len(),
-    )?;
+    let Prepared {
+        strategy,
+        settings,
+        choices,
+        resolved,
+    } = prepared;
     let result = render_with_progress(&args, &scene, strategy.as_ref(), &settings)?;
     let written = report::write_images(&args, strategy.as_ref(), &settings, &result)?;
     let meta = report::metadata(

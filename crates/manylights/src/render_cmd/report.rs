@@ -14,6 +14,16 @@ pub(super) struct Written {
     aux_files: Vec<PathBuf>,
 }
 
+impl Written {
+    /// No preview and no aux file (a render kept in memory).
+    pub(super) fn nothing() -> Written {
+        Written {
+            exposure: 0.0,
+            aux_files: Vec::new(),
+        }
+    }
+}
+
 fn sibling(out: &Path, suffix: &str) -> PathBuf {
     let stem = out
         .file_stem()
