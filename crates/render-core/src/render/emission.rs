@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 impl PassJob<'_> {
     /// The `rays − 1` extra emission rays of pixel `index`'s sample `sample_index`: the sum of
-    /// their filter-weighted emission and how many saw a light.
+    /// their filter-weighted emission and how many saw a light (none for a sample of one ray).
     pub(super) fn extra_emission(
         &self,
         index: usize,
@@ -19,6 +19,9 @@ impl PassJob<'_> {
         rays: u32,
         c: &mut Counters,
     ) -> (Vec3, u32) {
+        if rays <= 1 {
+            return (Vec3::ZERO, 0);
+        }
         let s = self.settings;
         let grid = self.grid;
         let (x, y) = grid.image_xy(index);

@@ -42,11 +42,7 @@ impl Passes {
             if let Some(sp) = &sp {
                 camera.distant = distant_lighting(job.scene, sp, c);
             }
-            let extra = if rays == 1 {
-                (Vec3::ZERO, 0)
-            } else {
-                job.extra_emission(i, sample_index, rays, c)
-            };
+            let extra = job.extra_emission(i, sample_index, rays, c);
             let sample = PixelSample {
                 on_film,
                 weight,

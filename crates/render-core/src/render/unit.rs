@@ -66,11 +66,7 @@ impl PassJob<'_> {
                 &mut ctx,
             );
             let aux = ctx.aux;
-            let extra = if rays == 1 {
-                (Vec3::ZERO, 0)
-            } else {
-                self.extra_emission(index, sample_index, rays, c)
-            };
+            let extra = self.extra_emission(index, sample_index, rays, c);
             let sample = PixelSample {
                 on_film,
                 weight,
