@@ -25,6 +25,7 @@ pub mod material;
 pub mod metrics;
 pub mod output;
 pub mod pilot;
+mod ray_streams;
 pub mod render;
 pub mod sampling;
 pub mod scene;

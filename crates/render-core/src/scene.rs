@@ -135,12 +135,8 @@ impl Scene {
     /// True when the segment from `origin` (already offset off its surface) along `dir` up to
     /// `dist` is blocked. The far end is shortened so the light's own surface never occludes.
     pub fn occluded(&self, origin: Vec3, dir: Vec3, dist: f32) -> bool {
-        self.accel.occluded(
-            origin,
-            dir,
-            0.0,
-            dist * (1.0 - 1e-4) - ray_epsilon(origin + dir * dist),
-        )
+        let r = self.shadow_ray(origin, dir, dist);
+        self.accel.occluded(r.origin, r.dir, r.tmin, r.tmax)
     }
 
     /// Scene diagonal, a length scale for defaults.

@@ -157,6 +157,34 @@ impl Accel {
     }
 }
 
+/// A ray of a stream: the segment t in [tmin, tmax) of origin + t·dir.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StreamRay {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    pub tmin: f32,
+    pub tmax: f32,
+}
+
+impl Accel {
+    /// [`Accel::intersect`] of every ray of `rays`, into `hits` in the same order: the same
+    /// hits bit for bit, whatever the stream's length.
+    pub fn intersect_stream(&self, rays: &[StreamRay], hits: &mut [Option<Hit>]) {
+        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
+        for (r, h) in rays.iter().zip(hits) {
+            *h = self.intersect(r.origin, r.dir, r.tmin, r.tmax);
+        }
+    }
+
+    /// [`Accel::occluded`] of every ray of `rays`, into `blocked` in the same order.
+    pub fn occluded_stream(&self, rays: &[StreamRay], blocked: &mut [bool]) {
+        assert_eq!(rays.len(), blocked.len(), "one answer per ray");
+        for (r, b) in rays.iter().zip(blocked) {
+            *b = self.occluded(r.origin, r.dir, r.tmin, r.tmax);
+        }
+    }
+}
+
 /// The node test picks a box's near slab by the sign of 1/d: a −0.0 component would give −∞
 /// and the far slab. Adding +0.0 turns −0.0 into +0.0.
 #[inline(always)]
