@@ -146,6 +146,47 @@ fn exr_bytes_do_not_depend_on_thread_count() {
     }
 }
 
+/// `--engine` changes how samples are shaded, never the image: the batched and per-sample
+/// engines write the same EXR, and the JSON says which engine ran (the method has no batched
+/// form yet, so it runs per sample whatever is asked).
+#[test]
+fn engine_flag_leaves_the_image_alone_and_is_recorded() {
+    let dir = temp_dir("engine");
+    let mut exrs = Vec::new();
+    for (engine, strategy, used) in [
+        ("batched", "power+bsdf", "batched"),
+        ("per-sample", "power+bsdf", "per-sample"),
+        ("batched", "mis3-adaptive", "per-sample"),
+    ] {
+        let name = format!("{engine}-{}", strategy.replace('+', "_"));
+        let out = dir.join(format!("{name}.exr"));
+        let o = manylights(&[
+            "render",
+            SCENE,
+            "--strategy",
+            strategy,
+            "--engine",
+            engine,
+            "--spp",
+            "2",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let json = std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap();
+        let meta: serde_json::Value = serde_json::from_str(&json).unwrap();
+        assert_eq!(meta["engine"], engine);
+        assert_eq!(meta["engine_used"], used, "{name}");
+        exrs.push(std::fs::read(dir.join(format!("{name}.exr"))).unwrap());
+    }
+    assert!(exrs[0] == exrs[1], "the engines' images differ");
+}
+
 /// Renders SCENE at 16×16 into `dir/t.exr` with a time budget and `extra` flags; its JSON.
 fn render_with_budget(dir: &Path, seconds: &str, extra: &[&str]) -> serde_json::Value {
     let out = dir.join("t.exr");

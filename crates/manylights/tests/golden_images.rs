@@ -56,6 +56,7 @@ fn render_case(scene: &Scene, strategy: &str, opts: &StrategyOptions) -> u64 {
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     };
     hash_render(&render(scene, s.as_ref(), &settings, &|_, _| {}).unwrap())
 }

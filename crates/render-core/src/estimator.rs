@@ -62,6 +62,12 @@ pub trait DirectLighting: Send + Sync {
     fn image_space(&self) -> Option<&dyn crate::image_space::ImageSpaceLighting> {
         None
     }
+    /// The strategy's batched form, if it has one (`crate::batch`): the render loop then
+    /// shades a work unit's camera samples together through it (unless the render asks for
+    /// the per-sample engine). It must give every point `estimate`'s value bit for bit.
+    fn batched(&self) -> Option<&dyn crate::batch::BatchLighting> {
+        None
+    }
     /// Called once before a render's first sample: forget what an earlier render taught.
     fn begin_render(&self) {}
     /// The weight of pass `pass` (from 0) in every pixel's average, > 0: a function of the

@@ -11,6 +11,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod accel;
+pub mod batch;
 pub mod bsdf;
 pub mod camera;
 pub mod colour;

@@ -1,5 +1,6 @@
 //! A camera-ray hit ready for direct lighting: the point, the direction to the viewer and the
 //! BSDF there, with the shadow-ray helpers every strategy uses.
+use crate::accel::StreamRay;
 use crate::bsdf::Bsdf;
 use crate::light::LightSample;
 use crate::scene::{Scene, SurfaceHit, offset_origin};
@@ -45,9 +46,23 @@ impl ShadingPoint {
         s: &LightSample,
         counters: &mut Counters,
     ) -> (Vec3, f32) {
+        let (f, pdf) = self.unshadowed_with_pdf(s);
+        (self.unless_occluded(scene, s, f, counters), pdf)
+    }
+
+    /// [`ShadingPoint::shade_with_pdf`] before its shadow ray: the unshadowed f·cos·L and the
+    /// BSDF's density of the direction.
+    #[inline]
+    pub fn unshadowed_with_pdf(&self, s: &LightSample) -> (Vec3, f32) {
         let v = self.bsdf.eval(self.wo, s.wi);
-        let f = self.unless_occluded(scene, s, v.f_cos * s.radiance, counters);
-        (f, v.pdf)
+        (v.f_cos * s.radiance, v.pdf)
+    }
+
+    /// The shadow ray of a light sample: the segment [`ShadingPoint::shade`] tests.
+    #[inline]
+    pub fn shadow_ray(&self, scene: &Scene, s: &LightSample) -> StreamRay {
+        let o = self.origin_towards(s.wi);
+        scene.shadow_ray(o, s.wi, (s.point - o).length())
     }
 
     /// `f`, or zero when it is zero or the light sample's shadow ray is blocked.
@@ -63,8 +78,8 @@ impl ShadingPoint {
             return Vec3::ZERO;
         }
         counters.shadow_rays += 1;
-        let o = self.origin_towards(s.wi);
-        if scene.occluded(o, s.wi, (s.point - o).length()) {
+        let r = self.shadow_ray(scene, s);
+        if scene.accel.occluded(r.origin, r.dir, r.tmin, r.tmax) {
             Vec3::ZERO
         } else {
             f

@@ -63,6 +63,7 @@ fn main() -> Result<(), String> {
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     };
     render(&scene, &strategy, &settings, &|_, _| {})?;
 

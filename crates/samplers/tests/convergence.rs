@@ -248,6 +248,7 @@ fn a_strategy_object_renders_the_same_image_twice() {
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     };
     let a = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
     let b = render(&scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap();
@@ -288,6 +289,7 @@ fn bisml_cornell_from_pbrt_agrees_with_its_gltf() {
             filter: Default::default(),
             reconstruction: Default::default(),
             emission_rays: Default::default(),
+            engine: Default::default(),
         };
         render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
     };

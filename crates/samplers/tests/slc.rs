@@ -85,6 +85,7 @@ fn render_with(
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     };
     render(scene, strategy, &settings, &|_, _| {}).unwrap()
 }

@@ -47,6 +47,7 @@ fn settings(scene: &Scene, (w, h): (u32, u32), spp: u32, threads: usize) -> Rend
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     }
 }
 

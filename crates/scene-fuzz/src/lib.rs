@@ -323,6 +323,7 @@ fn load_and_render(path: &Path, case: u64) -> Result<Outcome, String> {
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     };
     match render_core::render::render(&scene, strategy.as_ref(), &settings, &|_, _| {}) {
         Ok(r) => {

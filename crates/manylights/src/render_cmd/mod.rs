@@ -11,7 +11,7 @@ use render_core::estimator::DirectLighting;
 use render_core::filter::PixelFilter;
 use render_core::light_points::LightPoints;
 use render_core::output::write_json;
-use render_core::render::{BudgetClock, RenderResult, RenderSettings, TimeBudget, render};
+use render_core::render::{BudgetClock, Engine, RenderResult, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
 use render_core::scene::Scene;
 use render_core::splat::Reconstruction;
@@ -72,6 +72,12 @@ pub struct RenderArgs {
     /// Worker threads (default: one per CPU). The image does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
+    /// How camera samples go through shading: `batched` (a work unit's samples in phases
+    /// together, their rays traced as streams, for the strategies that have a batched form)
+    /// or `per-sample` (one camera sample at a time, every ray alone); the JSON's
+    /// `engine_used` says which ran. The image does not depend on it.
+    #[arg(long, value_enum, default_value = "batched")]
+    pub engine: EngineArg,
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
     #[arg(long)]
     pub aux: bool,
@@ -162,6 +168,13 @@ impl StrategyArgs {
 pub enum BudgetClockArg {
     Wall,
     Cpu,
+}
+
+/// `--engine`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum EngineArg {
+    Batched,
+    PerSample,
 }
 
 /// The sampler a render uses, and why: `--sampler`, else the scene file's, else pbrt-v3's
@@ -341,6 +354,10 @@ fn settings(
         filter: choices.filter.0.clone(),
         reconstruction,
         emission_rays: EmissionRays::new(emission_rays).map_err(anyhow::Error::msg)?,
+        engine: match args.engine {
+            EngineArg::Batched => Engine::Batched,
+            EngineArg::PerSample => Engine::PerSample,
+        },
     })
 }
 

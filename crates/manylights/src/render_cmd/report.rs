@@ -130,6 +130,8 @@ pub(super) fn metadata(
         "height": settings.height,
         "camera": settings.camera,
         "threads": args.threads,
+        "engine": settings.engine.name(),
+        "engine_used": settings.engine.used_for(strategy),
         "worker_threads": result.threads,
         "wall_seconds": result.wall_seconds,
         "cpu_seconds": result.cpu_seconds,

@@ -15,6 +15,7 @@
 //! pixel's running sums, the memory check), `passes.rs` (the passes and their work units),
 //! `pass_job.rs` (what the units share), `unit.rs` (one unit's samples), `shading.rs` (a camera
 //! ray's shading), `emission.rs` (extra emission rays), `pilot_run.rs` (a strategy's pilot) and
+//! `unit_batch.rs` (a unit's samples in phases, through a strategy's batched form, `crate::batch`),
 //! `image_pass.rs` (a pass of a strategy that works on the whole image, `crate::image_space`)
 //! and `finish.rs` (the image and its diagnostics).
 mod accum;
@@ -29,11 +30,12 @@ mod shading;
 #[cfg(test)]
 mod tests;
 mod unit;
+mod unit_batch;
 
 pub use accum::{check_memory, memory_estimate};
 pub use finish::RenderResult;
 pub use pass_job::UNIT_PIXELS;
-pub use settings::{BudgetClock, RenderSettings, TimeBudget};
+pub use settings::{BudgetClock, Engine, RenderSettings, TimeBudget};
 pub use shading::shading_point;
 
 use crate::estimator::{DirectLighting, MAX_AUX};

@@ -33,6 +33,43 @@ pub struct RenderSettings {
     /// Camera rays per sample that gather the emission seen directly (`emission_rays.rs`;
     /// more than one only under `Reconstruction::Sampled`).
     pub emission_rays: EmissionRays,
+    /// How camera samples go through shading: in batches where the strategy can, or one at a
+    /// time. Both give the same image.
+    pub engine: Engine,
+}
+
+/// How a render's camera samples go through shading (`crate::batch`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Engine {
+    /// A work unit's samples in phases together, rays traced as streams, for every strategy
+    /// with a batched form ([`crate::estimator::DirectLighting::batched`]); the others one at
+    /// a time.
+    #[default]
+    Batched,
+    /// Every strategy one camera sample at a time, each ray traced alone.
+    PerSample,
+}
+
+impl Engine {
+    /// What shades `strategy`'s camera samples when a render asks for this engine:
+    /// `image-space` (its whole-image passes), `batched` or `per-sample`.
+    pub fn used_for(self, strategy: &dyn crate::estimator::DirectLighting) -> &'static str {
+        if strategy.image_space().is_some() {
+            "image-space"
+        } else if self == Engine::Batched && strategy.batched().is_some() {
+            "batched"
+        } else {
+            "per-sample"
+        }
+    }
+
+    /// The name the command line and the render's JSON use.
+    pub fn name(self) -> &'static str {
+        match self {
+            Engine::Batched => "batched",
+            Engine::PerSample => "per-sample",
+        }
+    }
 }
 
 /// A render-time limit, checked before each work unit.

@@ -1,5 +1,6 @@
 //! A camera ray's shading: the emission it sees, the strategy's estimate at its hit and the
 //! distant lights there.
+use crate::accel::StreamRay;
 use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::estimator::{DirectLighting, SampleContext, ShadingPoint};
@@ -46,9 +47,30 @@ pub(super) fn camera_hit(
     film: Vec2,
     counters: &mut Counters,
 ) -> (CameraSample, Option<ShadingPoint>) {
-    let dir = camera.ray_direction(film, aspect);
+    let ray = camera_ray(camera, aspect, film);
+    let hit = scene.intersect(ray.origin, ray.dir, ray.tmin, ray.tmax);
+    seen_by_camera(scene, ray.dir, hit, counters)
+}
+
+/// The camera ray through `film` (in [0, 1]²).
+pub(super) fn camera_ray(camera: &Camera, aspect: f32, film: Vec2) -> StreamRay {
+    StreamRay {
+        origin: camera.position,
+        dir: camera.ray_direction(film, aspect),
+        tmin: 0.0,
+        tmax: f32::INFINITY,
+    }
+}
+
+/// [`camera_hit`] once the camera ray along `dir` has been traced to `hit`.
+pub(super) fn seen_by_camera(
+    scene: &Scene,
+    dir: Vec3,
+    hit: Option<SurfaceHit>,
+    counters: &mut Counters,
+) -> (CameraSample, Option<ShadingPoint>) {
     counters.camera_rays += 1;
-    let Some(hit) = scene.intersect(camera.position, dir, 0.0, f32::INFINITY) else {
+    let Some(hit) = hit else {
         return (CameraSample::default(), None);
     };
     let wo = -dir;

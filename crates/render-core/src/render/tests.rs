@@ -168,6 +168,7 @@ fn settings(
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     }
 }
 

@@ -45,6 +45,17 @@ impl PassJob<'_> {
         (unit, splats): (&mut [PixelAccum], &mut [PassSample]),
         c: &mut Counters,
     ) {
+        if self.settings.engine == super::Engine::Batched
+            && let Some(batched) = self.strategy.batched()
+        {
+            return self.render_unit_batched(
+                batched,
+                u,
+                (sample_index, pass_weight),
+                (unit, splats),
+                c,
+            );
+        }
         for (i, px) in unit.iter_mut().enumerate() {
             let index = u * UNIT_PIXELS + i;
             let mut rng = self.sample_stream(index, sample_index);

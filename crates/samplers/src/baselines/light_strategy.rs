@@ -93,6 +93,10 @@ impl<S: LightSelection> DirectLighting for LightStrategy<S> {
         }
     }
 
+    fn batched(&self) -> Option<&dyn render_core::batch::BatchLighting> {
+        Some(self)
+    }
+
     fn estimate(
         &self,
         scene: &Scene,

@@ -3,6 +3,7 @@
 //! cut ([`tree_selection`]), the spherical-Gaussian light tree of Tokuyoshi et al. 2024 ([`sg`]),
 //! BSDF sampling alone, and the oracle floors ([`oracle`]); each as a strategy through
 //! [`light_strategy::LightStrategy`] (a selection, with or without BSDF sampling by MIS).
+mod light_batch;
 pub mod light_strategy;
 pub mod oracle;
 pub mod selection;

@@ -280,6 +280,7 @@ pub fn render_film(
         filter,
         reconstruction,
         emission_rays: Default::default(),
+        engine: Default::default(),
     };
     render(scene, strategy.as_ref(), &settings, &|_, _| {}).unwrap()
 }

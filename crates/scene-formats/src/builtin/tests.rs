@@ -422,6 +422,7 @@ fn every_builtin_renders_a_lit_image() {
             filter: Default::default(),
             reconstruction: Default::default(),
             emission_rays: Default::default(),
+            engine: Default::default(),
         };
         let r = render(&scene, &UniformLights, &settings, &|_, _| {}).unwrap();
         // Leave out pixels that see a light directly: the rest is reflected light.

@@ -1,0 +1,77 @@
+//! One work unit of a pass through a strategy's batched form (`crate::batch`), in phases:
+//! every pixel's film position and camera ray, the camera rays traced as one stream, the
+//! shading points lit together by the strategy, then each sample's distant lights and extra
+//! emission rays and its accumulation, exactly as `unit.rs` does one pixel at a time.
+use super::accum::PixelAccum;
+use super::pass_job::{PassJob, UNIT_PIXELS};
+use super::shading::{camera_ray, distant_lighting, seen_by_camera};
+use super::unit::PixelSample;
+use crate::batch::{BatchLighting, ShadingBatch};
+use crate::estimator::MAX_AUX;
+use crate::splat::PassSample;
+use crate::stats::Counters;
+use glam::Vec3;
+
+impl PassJob<'_> {
+    /// [`PassJob::render_unit`] through `strategy`, the same samples bit for bit.
+    pub(super) fn render_unit_batched(
+        &self,
+        strategy: &dyn BatchLighting,
+        u: usize,
+        (sample_index, pass_weight): (u64, f64),
+        (unit, splats): (&mut [PixelAccum], &mut [PassSample]),
+        c: &mut Counters,
+    ) {
+        let n = unit.len();
+        let mut rngs = Vec::with_capacity(n);
+        let mut films = Vec::with_capacity(n);
+        let mut rays = Vec::with_capacity(n);
+        for i in 0..n {
+            let index = u * UNIT_PIXELS + i;
+            let mut rng = self.sample_stream(index, sample_index);
+            let (on_film, film, weight) = self.film_position(index, &mut rng);
+            rays.push(camera_ray(&self.settings.camera, self.aspect, film));
+            films.push((on_film, weight));
+            rngs.push(rng);
+        }
+        let (mut hits, mut surfaces) = (Vec::new(), Vec::new());
+        self.scene.intersect_stream(&rays, &mut hits, &mut surfaces);
+        let mut cameras = Vec::with_capacity(n);
+        let mut points = Vec::with_capacity(n);
+        for (ray, hit) in rays.iter().zip(surfaces) {
+            let (camera, sp) = seen_by_camera(self.scene, ray.dir, hit, c);
+            cameras.push(camera);
+            points.push(sp);
+        }
+        let mut direct = vec![Vec3::ZERO; n];
+        strategy.estimate_batch(
+            self.scene,
+            ShadingBatch {
+                points: &points,
+                rngs: &mut rngs,
+                counters: c,
+                out: &mut direct,
+            },
+        );
+        let samples = cameras.into_iter().zip(&points).zip(direct).zip(films);
+        for (i, (((mut camera, sp), l), (on_film, weight))) in samples.enumerate() {
+            let index = u * UNIT_PIXELS + i;
+            let px = &mut unit[i];
+            let rays = self.settings.emission_rays.rays_for(px.split);
+            if let Some(sp) = sp {
+                camera.direct = l;
+                camera.distant = distant_lighting(self.scene, sp, c);
+            }
+            let extra = self.extra_emission(index, sample_index, rays, c);
+            let sample = PixelSample {
+                on_film,
+                weight,
+                rays,
+                camera,
+                extra,
+                aux: [0.0; MAX_AUX],
+            };
+            self.accumulate(px, splats.get_mut(i), sample, pass_weight);
+        }
+    }
+}
