@@ -27,6 +27,12 @@ impl Scene {
         hits.clear();
         hits.resize(rays.len(), None);
         self.accel.intersect_stream(rays, hits);
+        // Every hit triangle's record starts loading before the first is read.
+        for h in hits.iter().flatten() {
+            if let Some(tri) = self.triangles.get(h.prim as usize) {
+                crate::accel::prefetch(tri);
+            }
+        }
         out.clear();
         out.extend(
             rays.iter()

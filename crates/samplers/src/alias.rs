@@ -86,6 +86,14 @@ impl AliasTable {
         }
     }
 
+    /// Starts loading the bin [`AliasTable::sample`] reads for `bits`.
+    #[inline]
+    pub fn prefetch(&self, bits: u64) {
+        let n = self.bins.len();
+        let i = (((bits as u128 * n as u128) >> 64) as usize).min(n - 1);
+        render_core::accel::prefetch(&self.bins[i]);
+    }
+
     /// Probability of entry `i` (what [`AliasTable::sample`] reports with it).
     #[inline]
     pub fn pmf(&self, i: usize) -> f32 {

@@ -6,7 +6,7 @@
 mod collapse;
 mod lanes;
 mod node;
-pub(crate) use node::prefetch;
+pub use node::prefetch;
 mod packet;
 mod traverse;
 

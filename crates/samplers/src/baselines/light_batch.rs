@@ -74,6 +74,11 @@ impl<S: LightSelection> LightStrategy<S> {
         counters: &mut Counters,
         out: &mut [Vec3],
     ) {
+        for (sp, rng) in points.iter().zip(rngs.iter()) {
+            if sp.is_some() {
+                self.selection.prefetch_pick(rng);
+            }
+        }
         let mut picks = Vec::new();
         let mut work: Vec<_> = (points.iter().zip(rngs.iter_mut()).enumerate())
             .filter_map(|(i, (sp, rng))| {

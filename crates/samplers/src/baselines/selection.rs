@@ -27,6 +27,9 @@ pub trait LightSelection: Send + Sync {
     );
     /// Probability with which the pick of the part containing `light` chooses it.
     fn pmf(&self, state: &Self::State, sp: &ShadingPoint, light: u32) -> f32;
+    /// A hint before a batch's picks: start loading what the pick from `rng` (left as it is)
+    /// will read. Changes nothing but when memory arrives.
+    fn prefetch_pick(&self, _rng: &SampleStream) {}
 }
 
 /// Every light equally likely.
@@ -95,6 +98,11 @@ impl LightSelection for PowerSelection {
     }
     fn pmf(&self, _: &(), _: &ShadingPoint, light: u32) -> f32 {
         self.table.as_ref().map_or(0.0, |t| t.pmf(light as usize))
+    }
+    fn prefetch_pick(&self, rng: &SampleStream) {
+        if let Some(t) = &self.table {
+            t.prefetch(rng.clone().next_u64());
+        }
     }
 }
 
