@@ -51,15 +51,11 @@ struct Pending {
     ray: usize,
 }
 
-/// Shading points that go through the phases together. A point's selection state (an E&K
-/// cut, say) lives from its first phase to its last, so the group is kept small enough for
-/// the states to stay in cache while still giving the ray streams some length.
-const GROUP: usize = 32;
-
 impl<S: LightSelection> BatchLighting for LightStrategy<S> {
     fn estimate_batch(&self, scene: &Scene, b: ShadingBatch<'_>) {
-        let groups = b.points.chunks(GROUP).zip(b.rngs.chunks_mut(GROUP));
-        for ((points, rngs), out) in groups.zip(b.out.chunks_mut(GROUP)) {
+        let g = self.selection.batch_group();
+        let groups = b.points.chunks(g).zip(b.rngs.chunks_mut(g));
+        for ((points, rngs), out) in groups.zip(b.out.chunks_mut(g)) {
             self.estimate_group(scene, (points, rngs), b.counters, out);
         }
     }

@@ -177,6 +177,13 @@ impl LightSelection for TreeSelection {
         self.prepare_impl(sp, None)
     }
 
+    fn batch_group(&self) -> usize {
+        match self.mode {
+            TreeMode::Split(_) => 8,
+            _ => 64,
+        }
+    }
+
     fn clusters(&self, state: &TreeState) -> usize {
         state.cut().map_or(0, Cut::len)
     }
