@@ -1,17 +1,23 @@
 //! Ray casting through our own eight-wide BVH over triangles and sphere lights, collapsed
 //! from obvhs's binary build: children's float bounds side by side (`node`), primitives four
 //! to a packet (`packet`), closest hit nearest child first and occlusion with an any-hit exit
-//! (`traverse`). The node test runs on AVX2 when the CPU has it, on SSE2 otherwise; both give
-//! the same hits bit for bit (see [`Simd`]).
+//! (`traverse`), and streams of rays several at a time (`stream`). The node test runs on
+//! AVX-512 or AVX2 when the CPU has it, on SSE2 otherwise; all give the same hits bit for bit
+//! (see [`Simd`]).
 mod collapse;
+mod isa;
 mod lanes;
 mod node;
+mod node16;
 pub use node::prefetch;
 mod packet;
+mod stream;
 mod traverse;
 
 #[cfg(test)]
 mod simd_paths_tests;
+#[cfg(test)]
+mod stream_tests;
 
 use collapse::Wide;
 use glam::Vec3;
@@ -39,10 +45,12 @@ pub struct Hit {
     pub b2: f32,
 }
 
-/// The instruction set the node test runs on. Both do the same float operations per lane in
+/// The instruction set the node test runs on. All do the same float operations per lane in
 /// the same order (none fused), so they return the same hits bit for bit.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Simd {
+    /// Eight children's near and far slabs in one 16-lane pass (AVX-512F).
+    Avx512,
     /// Eight children in one 8-lane pass.
     Avx2,
     /// Eight children in two 4-lane passes (SSE2 on x86-64, plain arrays elsewhere).
@@ -50,13 +58,41 @@ pub enum Simd {
 }
 
 impl Simd {
-    /// The best this CPU runs: AVX2 where `is_x86_feature_detected!` finds it.
+    /// Every path, the widest first.
+    pub const ALL: [Simd; 3] = [Simd::Avx512, Simd::Avx2, Simd::Sse2];
+
+    /// The best this CPU runs, as `is_x86_feature_detected!` finds it.
     pub fn detect() -> Simd {
+        Simd::ALL
+            .into_iter()
+            .find(|s| s.available())
+            .unwrap_or(Simd::Sse2)
+    }
+
+    /// Whether this CPU (and its OS) runs the path.
+    pub fn available(self) -> bool {
         #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            return Simd::Avx2;
+        {
+            use std::arch::is_x86_feature_detected as has;
+            match self {
+                Simd::Avx512 => has!("avx512f") && has!("avx2"),
+                Simd::Avx2 => has!("avx2"),
+                Simd::Sse2 => true,
+            }
         }
-        Simd::Sse2
+        #[cfg(not(target_arch = "x86_64"))]
+        {
+            self == Simd::Sse2
+        }
+    }
+
+    /// The instruction set's usual name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Simd::Avx512 => "AVX-512",
+            Simd::Avx2 => "AVX2",
+            Simd::Sse2 => "SSE2",
+        }
     }
 }
 
@@ -115,10 +151,10 @@ impl Accel {
         self.simd
     }
 
-    /// Traverse with `simd` from now on; [`Simd::Avx2`] on a CPU without it is an error.
+    /// Traverse with `simd` from now on; a path the CPU lacks is an error.
     pub fn set_simd(&mut self, simd: Simd) -> Result<(), String> {
-        if simd == Simd::Avx2 && Simd::detect() != Simd::Avx2 {
-            return Err("this CPU has no AVX2".into());
+        if !simd.available() {
+            return Err(format!("this CPU has no {}", simd.name()));
         }
         self.simd = simd;
         Ok(())
@@ -133,8 +169,11 @@ impl Accel {
         let dir = positive_zeros(dir);
         traverse::with_stack(self.stack_need, |stack| match self.simd {
             #[cfg(target_arch = "x86_64")]
-            // SAFETY: `simd` is Avx2 only where the CPU has AVX2 (`build`, `set_simd`).
-            Simd::Avx2 => unsafe { closest_avx2(w, origin, dir, tmin, tmax, stack) },
+            // SAFETY: `simd` names only a path the CPU has (`build`, `set_simd`).
+            Simd::Avx512 => unsafe { isa::avx512::closest(w, origin, dir, tmin, tmax, stack) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
+            Simd::Avx2 => unsafe { isa::avx2::closest(w, origin, dir, tmin, tmax, stack) },
             _ => traverse::closest::<node::Lanes4>(w, origin, dir, tmin, tmax, stack),
         })
     }
@@ -151,7 +190,10 @@ impl Accel {
         traverse::with_stack(self.stack_need, |stack| match self.simd {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as in `intersect`.
-            Simd::Avx2 => unsafe { occluded_avx2(w, origin, dir, tmin, tmax, stack) },
+            Simd::Avx512 => unsafe { isa::avx512::occluded(w, origin, dir, tmin, tmax, stack) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `intersect`.
+            Simd::Avx2 => unsafe { isa::avx2::occluded(w, origin, dir, tmin, tmax, stack) },
             _ => traverse::occluded::<node::Lanes4>(w, origin, dir, tmin, tmax, stack),
         })
     }
@@ -168,19 +210,43 @@ pub struct StreamRay {
 
 impl Accel {
     /// [`Accel::intersect`] of every ray of `rays`, into `hits` in the same order: the same
-    /// hits bit for bit, whatever the stream's length.
+    /// hits bit for bit, whatever the stream's length. The rays' traversals are interleaved
+    /// so that one ray's memory loads overlap the others' tests.
     pub fn intersect_stream(&self, rays: &[StreamRay], hits: &mut [Option<Hit>]) {
         assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        for (r, h) in rays.iter().zip(hits) {
-            *h = self.intersect(r.origin, r.dir, r.tmin, r.tmax);
+        let Some(w) = self.wide.as_ref() else {
+            hits.fill(None);
+            return;
+        };
+        let need = self.stack_need;
+        match self.simd {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `intersect`.
+            Simd::Avx512 => unsafe { isa::avx512::closest_stream(w, need, rays, hits) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `intersect`.
+            Simd::Avx2 => unsafe { isa::avx2::closest_stream(w, need, rays, hits) },
+            _ => stream::closest_stream::<node::Lanes4>(w, need, rays, hits),
         }
     }
 
-    /// [`Accel::occluded`] of every ray of `rays`, into `blocked` in the same order.
+    /// [`Accel::occluded`] of every ray of `rays`, into `blocked` in the same order, the
+    /// traversals interleaved as in [`Accel::intersect_stream`].
     pub fn occluded_stream(&self, rays: &[StreamRay], blocked: &mut [bool]) {
         assert_eq!(rays.len(), blocked.len(), "one answer per ray");
-        for (r, b) in rays.iter().zip(blocked) {
-            *b = self.occluded(r.origin, r.dir, r.tmin, r.tmax);
+        let Some(w) = self.wide.as_ref() else {
+            blocked.fill(false);
+            return;
+        };
+        let need = self.stack_need;
+        match self.simd {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `intersect`.
+            Simd::Avx512 => unsafe { isa::avx512::occluded_stream(w, need, rays, blocked) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as in `intersect`.
+            Simd::Avx2 => unsafe { isa::avx2::occluded_stream(w, need, rays, blocked) },
+            _ => stream::occluded_stream::<node::Lanes4>(w, need, rays, blocked),
         }
     }
 }
@@ -188,34 +254,8 @@ impl Accel {
 /// The node test picks a box's near slab by the sign of 1/d: a −0.0 component would give −∞
 /// and the far slab. Adding +0.0 turns −0.0 into +0.0.
 #[inline(always)]
-fn positive_zeros(d: Vec3) -> Vec3 {
+pub(crate) fn positive_zeros(d: Vec3) -> Vec3 {
     d + Vec3::ZERO
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn closest_avx2(
-    w: &Wide,
-    o: Vec3,
-    d: Vec3,
-    tmin: f32,
-    tmax: f32,
-    stack: &mut [std::mem::MaybeUninit<traverse::Entry>],
-) -> Option<Hit> {
-    traverse::closest::<node::Avx2>(w, o, d, tmin, tmax, stack)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn occluded_avx2(
-    w: &Wide,
-    o: Vec3,
-    d: Vec3,
-    tmin: f32,
-    tmax: f32,
-    stack: &mut [std::mem::MaybeUninit<traverse::Entry>],
-) -> bool {
-    traverse::occluded::<node::Avx2>(w, o, d, tmin, tmax, stack)
 }
 
 #[cfg(test)]

@@ -45,7 +45,7 @@ pub fn leaf_parts(code: u32) -> (u32, u32, u32) {
 #[repr(C, align(64))]
 pub struct Node8 {
     /// min x, max x, min y, max y, min z, max z.
-    bounds: [[f32; 8]; ROWS],
+    pub(super) bounds: [[f32; 8]; ROWS],
     pub child: [u32; 8],
 }
 
@@ -75,16 +75,17 @@ impl Node8 {
 /// What the node test needs of a ray: origin, inverse direction, and per axis the row of
 /// the near and the far slab (min first for a non-negative direction).
 pub struct BoxRay {
-    o: [f32; 3],
-    inv: [f32; 3],
-    near: [usize; 3],
-    far: [usize; 3],
-    tmin: f32,
+    pub(super) o: [f32; 3],
+    pub(super) inv: [f32; 3],
+    pub(super) near: [usize; 3],
+    pub(super) far: [usize; 3],
+    pub(super) tmin: f32,
 }
 
 /// pbrt's widening of the far slab distance, 1 + 2γ₃, so rounding never loses a box the ray
 /// grazes.
-const FAR_SCALE: f32 = 1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
+pub(super) const FAR_SCALE: f32 =
+    1.0 + 2.0 * (3.0 * f32::EPSILON * 0.5) / (1.0 - 3.0 * f32::EPSILON * 0.5);
 
 impl BoxRay {
     /// `d` must not hold −0.0 (the caller adds +0.0), so the sign picks the slab 1/d points to.

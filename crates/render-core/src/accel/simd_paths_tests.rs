@@ -88,7 +88,7 @@ fn brute_force(prims: &[Primitive], o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> O
 }
 
 /// xorshift64*: the test's own reproducible numbers in [0, 1).
-struct Rng(u64);
+pub(super) struct Rng(pub(super) u64);
 impl Rng {
     fn f(&mut self) -> f32 {
         self.0 ^= self.0 >> 12;
@@ -102,7 +102,7 @@ impl Rng {
 }
 
 /// A random soup: small triangles, some long thin ones, a few sharing edges, and spheres.
-fn soup(rng: &mut Rng) -> Vec<Primitive> {
+pub(super) fn soup(rng: &mut Rng) -> Vec<Primitive> {
     let mut prims = Vec::new();
     for k in 0..3000 {
         let v0 = rng.v(-10.0, 10.0);
@@ -128,25 +128,17 @@ fn soup(rng: &mut Rng) -> Vec<Primitive> {
     prims
 }
 
-fn bits(h: Option<Hit>) -> Option<(u32, u32, u32, u32)> {
+pub(super) fn bits(h: Option<Hit>) -> Option<(u32, u32, u32, u32)> {
     h.map(|h| (h.prim, h.t.to_bits(), h.b1.to_bits(), h.b2.to_bits()))
 }
 
-#[test]
-fn avx2_and_sse2_agree_bit_for_bit_and_match_brute_force() {
-    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
-    let prims = soup(&mut rng);
-    let mut sse = Accel::build(&prims);
-    sse.set_simd(Simd::Sse2).unwrap();
-    let fast = Accel::build(&prims);
-    if fast.simd() != Simd::Avx2 {
-        eprintln!("no AVX2 on this CPU: only the SSE2 path is checked against brute force");
-    }
-    let (mut hits, mut blocked) = (0, 0);
-    for k in 0..20_000 {
+/// `n` random rays through the soup's box, numbered, without the zero directions: some
+/// axis-aligned and some with zero components of both signs, a third of them finite segments.
+pub(super) fn random_rays(rng: &mut Rng, n: usize) -> Vec<(usize, StreamRay)> {
+    let mut rays = Vec::new();
+    for k in 0..n {
         let o = rng.v(-12.0, 12.0);
         let mut d = rng.v(-1.0, 1.0);
-        // Some axis-aligned directions and zero components, of both signs.
         match k % 11 {
             0 => d.x = 0.0,
             1 => d = Vec3::new(-0.0, 0.0, d.z),
@@ -156,12 +148,38 @@ fn avx2_and_sse2_agree_bit_for_bit_and_match_brute_force() {
         if d == Vec3::ZERO {
             continue;
         }
-        let d = d.normalize();
         let (tmin, tmax) = if k % 3 == 0 {
             (0.5, 4.0 + 20.0 * rng.f())
         } else {
             (0.0, f32::INFINITY)
         };
+        let dir = d.normalize();
+        rays.push((
+            k,
+            StreamRay {
+                origin: o,
+                dir,
+                tmin,
+                tmax,
+            },
+        ));
+    }
+    rays
+}
+
+#[test]
+fn avx2_and_sse2_agree_bit_for_bit_and_match_brute_force() {
+    let mut rng = Rng(0x9E37_79B9_7F4A_7C15);
+    let prims = soup(&mut rng);
+    let mut sse = Accel::build(&prims);
+    sse.set_simd(Simd::Sse2).unwrap();
+    let fast = Accel::build(&prims);
+    if fast.simd() == Simd::Sse2 {
+        eprintln!("no AVX2 on this CPU: only the SSE2 path is checked against brute force");
+    }
+    let (mut hits, mut blocked) = (0, 0);
+    for (k, r) in random_rays(&mut rng, 20_000) {
+        let (o, d, tmin, tmax) = (r.origin, r.dir, r.tmin, r.tmax);
         let a = fast.intersect(o, d, tmin, tmax);
         let b = sse.intersect(o, d, tmin, tmax);
         assert_eq!(bits(a), bits(b), "closest hit, ray {k}");
@@ -194,10 +212,16 @@ fn avx2_and_sse2_agree_bit_for_bit_and_match_brute_force() {
 }
 
 #[test]
-fn forcing_avx2_without_it_is_an_error() {
+fn forcing_a_path_the_cpu_lacks_is_an_error() {
     let mut a = Accel::build(&[]);
-    let r = a.set_simd(Simd::Avx2);
-    assert_eq!(r.is_ok(), Simd::detect() == Simd::Avx2);
+    for simd in Simd::ALL {
+        let r = a.set_simd(simd);
+        assert_eq!(r.is_ok(), simd.available(), "{simd:?}");
+        if let Err(e) = r {
+            assert!(e.contains(simd.name()), "{e}");
+        }
+    }
+    assert!(Simd::detect().available());
     assert!(a.set_simd(Simd::Sse2).is_ok());
     assert!(
         a.intersect(Vec3::ZERO, Vec3::Z, 0.0, f32::INFINITY)

@@ -5,7 +5,7 @@
 use super::Hit;
 use super::collapse::Wide;
 use super::lanes::F4;
-use super::node::{BoxRay, LEAF, NodeTest, leaf_parts, prefetch};
+use super::node::{BoxRay, LEAF, Node8, NodeTest, leaf_parts, prefetch};
 use super::packet::LaneRay;
 use glam::Vec3;
 use std::mem::MaybeUninit;
@@ -13,8 +13,8 @@ use std::mem::MaybeUninit;
 /// A stack entry: a child code and the distance at which the ray enters its box.
 #[derive(Clone, Copy)]
 pub struct Entry {
-    code: u32,
-    t: f32,
+    pub code: u32,
+    pub t: f32,
 }
 
 /// Stack entries kept on the call stack; deeper trees take a heap stack.
@@ -66,69 +66,88 @@ pub fn closest<N: NodeTest>(
         }
         if e.code & LEAF == 0 {
             let node = &w.nodes[e.code as usize];
-            let (mut mask, tnear) = N::test(node, &br, tmax);
-            let base = sp;
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                let x = Entry {
-                    code: node.child[i],
-                    t: tnear[i],
-                };
-                // Keep entries from `base` up in decreasing distance: the nearest on top.
-                let mut j = sp;
-                // SAFETY: entries below `sp` were written.
-                while j > base && unsafe { stack[j - 1].assume_init() }.t < x.t {
-                    stack[j] = stack[j - 1];
-                    j -= 1;
-                }
-                stack[j] = MaybeUninit::new(x);
-                sp += 1;
-            }
-            continue;
-        }
-        let (first, tris, spheres) = leaf_parts(e.code);
-        let first = first as usize;
-        for p in &w.packets[first..first + tris as usize] {
-            let (mut ok, t, b1, b2) = p.intersect_triangles(&lr, tmax);
-            if ok == 0 {
-                continue;
-            }
-            let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
-            while ok != 0 {
-                let l = ok.trailing_zeros() as usize;
-                ok &= ok - 1;
-                if t[l] < tmax {
-                    tmax = t[l];
-                    best = Some(Hit {
-                        prim: p.ids[l],
-                        t: t[l],
-                        b1: b1[l],
-                        b2: b2[l],
-                    });
-                }
-            }
-        }
-        let s0 = first + tris as usize;
-        for p in &w.packets[s0..s0 + spheres as usize] {
-            let (mut ok, t) = p.intersect_spheres(&lr, tmax);
-            let t = t.to_array();
-            while ok != 0 {
-                let l = ok.trailing_zeros() as usize;
-                ok &= ok - 1;
-                if t[l] < tmax {
-                    tmax = t[l];
-                    best = Some(Hit {
-                        prim: p.ids[l],
-                        t: t[l],
-                        b1: 0.0,
-                        b2: 0.0,
-                    });
-                }
-            }
+            let (mask, tnear) = N::test(node, &br, tmax);
+            push_nearest_on_top(node, mask, &tnear, stack, &mut sp);
+        } else {
+            leaf_closest(w, e.code, &lr, &mut tmax, &mut best);
         }
     }
     best
+}
+
+/// Pushes the children of `node` in `mask` with their entry distances, keeping the entries
+/// pushed here in decreasing distance (the nearest on top). Entries below `*sp` must be written.
+#[inline(always)]
+pub fn push_nearest_on_top(
+    node: &Node8,
+    mut mask: u32,
+    tnear: &[f32; 8],
+    stack: &mut [MaybeUninit<Entry>],
+    sp: &mut usize,
+) {
+    let base = *sp;
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        let x = Entry {
+            code: node.child[i],
+            t: tnear[i],
+        };
+        let mut j = *sp;
+        // SAFETY: entries below `sp` were written.
+        while j > base && unsafe { stack[j - 1].assume_init() }.t < x.t {
+            stack[j] = stack[j - 1];
+            j -= 1;
+        }
+        stack[j] = MaybeUninit::new(x);
+        *sp += 1;
+    }
+}
+
+/// Tests the primitives of leaf `code`, lowering `tmax` and replacing `best` at each strictly
+/// nearer hit (triangle packets first, lanes in order).
+#[inline(always)]
+pub fn leaf_closest(w: &Wide, code: u32, lr: &LaneRay, tmax: &mut f32, best: &mut Option<Hit>) {
+    let (first, tris, spheres) = leaf_parts(code);
+    let first = first as usize;
+    for p in &w.packets[first..first + tris as usize] {
+        let (mut ok, t, b1, b2) = p.intersect_triangles(lr, *tmax);
+        if ok == 0 {
+            continue;
+        }
+        let (t, b1, b2) = (t.to_array(), b1.to_array(), b2.to_array());
+        while ok != 0 {
+            let l = ok.trailing_zeros() as usize;
+            ok &= ok - 1;
+            if t[l] < *tmax {
+                *tmax = t[l];
+                *best = Some(Hit {
+                    prim: p.ids[l],
+                    t: t[l],
+                    b1: b1[l],
+                    b2: b2[l],
+                });
+            }
+        }
+    }
+    let s0 = first + tris as usize;
+    for p in &w.packets[s0..s0 + spheres as usize] {
+        let (mut ok, t) = p.intersect_spheres(lr, *tmax);
+        let t = t.to_array();
+        while ok != 0 {
+            let l = ok.trailing_zeros() as usize;
+            ok &= ok - 1;
+            if t[l] < *tmax {
+                *tmax = t[l];
+                *best = Some(Hit {
+                    prim: p.ids[l],
+                    t: t[l],
+                    b1: 0.0,
+                    b2: 0.0,
+                });
+            }
+        }
+    }
 }
 
 /// True when a primitive has t in [tmin, tmax).
@@ -143,7 +162,6 @@ pub fn occluded<N: NodeTest>(
 ) -> bool {
     let br = BoxRay::new(o, d, tmin);
     let lr = LaneRay::new(o, d, tmin);
-    let below = F4::splat(tmax);
     stack[0] = MaybeUninit::new(Entry { code: 0, t: tmin });
     let mut sp = 1;
     while sp > 0 {
@@ -157,32 +175,51 @@ pub fn occluded<N: NodeTest>(
         }
         if e.code & LEAF == 0 {
             let node = &w.nodes[e.code as usize];
-            let (mut mask, _) = N::test(node, &br, tmax);
-            while mask != 0 {
-                let i = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                stack[sp] = MaybeUninit::new(Entry {
-                    code: node.child[i],
-                    t: 0.0,
-                });
-                sp += 1;
-            }
-            continue;
+            let (mask, _) = N::test(node, &br, tmax);
+            push_as_found(node, mask, stack, &mut sp);
+        } else if leaf_blocks(w, e.code, &lr, tmax) {
+            return true;
         }
-        let (first, tris, spheres) = leaf_parts(e.code);
-        let first = first as usize;
-        for p in &w.packets[first..first + tris as usize] {
-            let (ok, t, _, _) = p.intersect_triangles(&lr, tmax);
-            if ok & t.lt(below) != 0 {
-                return true;
-            }
+    }
+    false
+}
+
+/// Pushes the children of `node` in `mask` in slot order (occlusion needs no distances).
+#[inline(always)]
+pub fn push_as_found(
+    node: &Node8,
+    mut mask: u32,
+    stack: &mut [MaybeUninit<Entry>],
+    sp: &mut usize,
+) {
+    while mask != 0 {
+        let i = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        stack[*sp] = MaybeUninit::new(Entry {
+            code: node.child[i],
+            t: 0.0,
+        });
+        *sp += 1;
+    }
+}
+
+/// True when a primitive of leaf `code` has t in [tmin, tmax).
+#[inline(always)]
+pub fn leaf_blocks(w: &Wide, code: u32, lr: &LaneRay, tmax: f32) -> bool {
+    let below = F4::splat(tmax);
+    let (first, tris, spheres) = leaf_parts(code);
+    let first = first as usize;
+    for p in &w.packets[first..first + tris as usize] {
+        let (ok, t, _, _) = p.intersect_triangles(lr, tmax);
+        if ok & t.lt(below) != 0 {
+            return true;
         }
-        let s0 = first + tris as usize;
-        for p in &w.packets[s0..s0 + spheres as usize] {
-            let (ok, t) = p.intersect_spheres(&lr, tmax);
-            if ok & t.lt(below) != 0 {
-                return true;
-            }
+    }
+    let s0 = first + tris as usize;
+    for p in &w.packets[s0..s0 + spheres as usize] {
+        let (ok, t) = p.intersect_spheres(lr, tmax);
+        if ok & t.lt(below) != 0 {
+            return true;
         }
     }
     false
@@ -190,7 +227,7 @@ pub fn occluded<N: NodeTest>(
 
 /// Prefetches what `code` names: a node, or a leaf's first packet.
 #[inline(always)]
-fn fetch(w: &Wide, code: u32) {
+pub fn fetch(w: &Wide, code: u32) {
     if code & LEAF == 0 {
         prefetch(&w.nodes[code as usize]);
     } else {

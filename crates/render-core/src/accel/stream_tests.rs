@@ -1,0 +1,169 @@
+//! Streams against single rays: in a stream of any length, on every SIMD path this CPU has,
+//! each ray's closest hit (primitive, distance and barycentrics, bit for bit) and occlusion
+//! are those of `Accel::intersect` and `Accel::occluded`; and the 16-lane node test, run as
+//! plain arrays, finds what the 4- and 8-lane ones find.
+use super::simd_paths_tests::{Rng, bits, random_rays, soup};
+use super::*;
+
+/// The paths this CPU runs, with a line for each one it lacks.
+fn paths() -> Vec<Simd> {
+    Simd::ALL
+        .into_iter()
+        .filter(|s| {
+            let ok = s.available();
+            if !ok {
+                eprintln!("this CPU has no {}: its path is not checked", s.name());
+            }
+            ok
+        })
+        .collect()
+}
+
+/// Rays a stream must answer as the single-ray calls do without a normal traversal.
+fn odd_rays() -> Vec<StreamRay> {
+    let ray = |origin, dir, tmin, tmax| StreamRay {
+        origin,
+        dir,
+        tmin,
+        tmax,
+    };
+    let d = Vec3::new(0.3, -0.2, 0.9).normalize();
+    vec![
+        ray(Vec3::ZERO, Vec3::NAN, 0.0, f32::INFINITY),
+        ray(
+            Vec3::new(f32::INFINITY, 0.0, 0.0),
+            -Vec3::X,
+            0.0,
+            f32::INFINITY,
+        ),
+        ray(Vec3::new(0.0, 0.0, 1e30), -Vec3::Z, 0.0, f32::INFINITY),
+        // An empty segment, a NaN end, and one wholly behind the origin.
+        ray(Vec3::new(1.0, 2.0, -3.0), d, 5.0, 1.0),
+        ray(Vec3::new(1.0, 2.0, -3.0), d, 0.0, f32::NAN),
+        ray(Vec3::new(1.0, 2.0, 3.0), d, -30.0, -1.0),
+        ray(Vec3::new(-1.0, 0.5, 2.0), -d, -30.0, -0.5),
+    ]
+}
+
+/// The soup's random rays with the odd ones spread among them.
+fn rays(rng: &mut Rng) -> Vec<StreamRay> {
+    let mut rays: Vec<StreamRay> = random_rays(rng, 20_000)
+        .into_iter()
+        .map(|(_, r)| r)
+        .collect();
+    for (i, r) in odd_rays().into_iter().enumerate() {
+        rays.insert(1 + 2_311 * i, r);
+    }
+    rays
+}
+
+#[test]
+fn streams_match_single_rays_bit_for_bit_on_every_path() {
+    let mut rng = Rng(0x5EED_0F57_AE4D_0001);
+    let prims = soup(&mut rng);
+    let rays = rays(&mut rng);
+    let mut accel = Accel::build(&prims);
+    accel.set_simd(Simd::Sse2).unwrap();
+    let single: Vec<_> = rays
+        .iter()
+        .map(|r| accel.intersect(r.origin, r.dir, r.tmin, r.tmax))
+        .collect();
+    let blocked: Vec<_> = rays
+        .iter()
+        .map(|r| accel.occluded(r.origin, r.dir, r.tmin, r.tmax))
+        .collect();
+    let found = single.iter().filter(|h| h.is_some()).count();
+    assert!(found > 2_000 && found < 18_000, "{found} hits");
+    assert!(blocked.iter().filter(|b| **b).count() > 2_000);
+    assert!(blocked.iter().any(|b| !b));
+    // Each slot starts wrong, so a slot the stream leaves alone fails.
+    let wrong = Some(Hit {
+        prim: u32::MAX,
+        t: -1.0,
+        b1: 0.0,
+        b2: 0.0,
+    });
+    for simd in paths() {
+        accel.set_simd(simd).unwrap();
+        for (k, r) in rays.iter().enumerate() {
+            let h = accel.intersect(r.origin, r.dir, r.tmin, r.tmax);
+            assert_eq!(bits(h), bits(single[k]), "{simd:?} single ray {k}");
+        }
+        for len in [1, 3, 17, 256] {
+            let mut hits = vec![wrong; rays.len()];
+            let mut occ: Vec<bool> = blocked.iter().map(|b| !b).collect();
+            for ((c, h), o) in rays
+                .chunks(len)
+                .zip(hits.chunks_mut(len))
+                .zip(occ.chunks_mut(len))
+            {
+                accel.intersect_stream(c, h);
+                accel.occluded_stream(c, o);
+            }
+            for k in 0..rays.len() {
+                assert_eq!(bits(hits[k]), bits(single[k]), "{simd:?}, {len}, ray {k}");
+                assert_eq!(occ[k], blocked[k], "{simd:?}, {len}, occlusion of ray {k}");
+            }
+        }
+    }
+}
+
+#[test]
+fn sixteen_lane_node_test_matches_on_this_cpu_as_arrays() {
+    let mut rng = Rng(0xA11_1A7E5);
+    let prims = soup(&mut rng);
+    let rays = rays(&mut rng);
+    let mut accel = Accel::build(&prims);
+    accel.set_simd(Simd::Sse2).unwrap();
+    let w = accel.wide.as_ref().unwrap();
+    let need = accel.stack_need;
+    let mut hits = vec![None; rays.len()];
+    let mut occ = vec![false; rays.len()];
+    stream::closest_stream::<node16::Array16>(w, need, &rays, &mut hits);
+    stream::occluded_stream::<node16::Array16>(w, need, &rays, &mut occ);
+    for (k, r) in rays.iter().enumerate() {
+        let h = accel.intersect(r.origin, r.dir, r.tmin, r.tmax);
+        assert_eq!(bits(hits[k]), bits(h), "ray {k}");
+        assert_eq!(
+            occ[k],
+            accel.occluded(r.origin, r.dir, r.tmin, r.tmax),
+            "ray {k}"
+        );
+        if !(r.origin.is_finite() && r.dir.is_finite()) {
+            continue;
+        }
+        let d = positive_zeros(r.dir);
+        let single = traverse::with_stack(need, |s| {
+            traverse::closest::<node16::Array16>(w, r.origin, d, r.tmin, r.tmax, s)
+        });
+        assert_eq!(bits(single), bits(h), "single ray {k}");
+    }
+}
+
+#[test]
+fn empty_scenes_and_streams_answer_nothing() {
+    let a = Accel::build(&[]);
+    let rays = odd_rays();
+    let mut hits = vec![
+        Some(Hit {
+            prim: 0,
+            t: 1.0,
+            b1: 0.0,
+            b2: 0.0,
+        });
+        rays.len()
+    ];
+    let mut occ = vec![true; rays.len()];
+    a.intersect_stream(&rays, &mut hits);
+    a.occluded_stream(&rays, &mut occ);
+    assert!(hits.iter().all(|h| h.is_none()));
+    assert!(occ.iter().all(|b| !b));
+    let mut prims = Vec::new();
+    prims.push(Primitive::Sphere {
+        center: Vec3::ZERO,
+        radius: 1.0,
+    });
+    let a = Accel::build(&prims);
+    a.intersect_stream(&[], &mut []);
+    a.occluded_stream(&[], &mut []);
+}
