@@ -33,6 +33,19 @@ fn main() {
         commit
     };
     println!("cargo:rustc-env=MANYLIGHTS_GIT_COMMIT={value}");
-    println!("cargo:rerun-if-changed=../../.git/HEAD");
-    println!("cargo:rerun-if-changed=../../.git/index");
+    // In a linked worktree `.git` is a file and HEAD and the index live in the worktree's own
+    // git directory; a path that does not exist would make Cargo rerun this on every build.
+    let git_dir = std::process::Command::new("git")
+        .args(["rev-parse", "--absolute-git-dir"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+    match git_dir {
+        Some(dir) => {
+            println!("cargo:rerun-if-changed={dir}/HEAD");
+            println!("cargo:rerun-if-changed={dir}/index");
+        }
+        None => println!("cargo:rerun-if-changed=build.rs"),
+    }
 }
