@@ -1,4 +1,5 @@
-//! Materials as scenes describe them (glTF metallic-roughness, or pbrt-v3's `plastic`);
+//! Materials as scenes describe them (glTF metallic-roughness, pbrt-v3's `plastic`, or a rough
+//! dielectric);
 //! [`crate::bsdf::BsdfParams`] is what one becomes at a hit.
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
@@ -35,6 +36,10 @@ pub enum Model {
     /// pbrt-v3 `plastic` (see [`crate::bsdf::plastic`]): Lambert Kd = the base colour, plus Ks × a
     /// Trowbridge–Reitz lobe of width `alpha` with pbrt-v3's dielectric Fresnel.
     PbrtPlastic { ks: Vec3, alpha: f32 },
+    /// A rough dielectric that transmits (see [`crate::bsdf::dielectric`]): index of
+    /// refraction `ior` behind the geometric normal (1 in front), GGX width `alpha`, and the
+    /// base colour (× its texture) as the transmission tint.
+    Dielectric { ior: f32, alpha: f32 },
 }
 
 impl Default for Material {

@@ -215,6 +215,19 @@ fn within_range(p: Vec3) -> bool {
 
 /// A material's factors must be finite and non-negative (NaN there makes NaN pixels).
 fn check_material(m: &Material) -> Result<(), SceneError> {
+    if let crate::material::Model::Dielectric { ior, alpha } = m.model {
+        let alpha_ok = alpha.is_finite() && alpha >= 0.0;
+        crate::bsdf::dielectric::check_ior(ior)
+            .and_then(|()| {
+                alpha_ok
+                    .then_some(())
+                    .ok_or(format!("alpha {alpha} must be finite and non-negative"))
+            })
+            .map_err(|message| SceneError::BadMaterial {
+                name: m.name.clone(),
+                message,
+            })?;
+    }
     let model_ok = match m.model {
         crate::material::Model::PbrtPlastic { ks, alpha } => {
             ks.is_finite() && ks.min_element() >= 0.0 && alpha.is_finite() && alpha >= 0.0

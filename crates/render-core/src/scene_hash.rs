@@ -219,6 +219,11 @@ fn hash_material(h: &mut ContentHasher, m: &Material, d: &mut TextureDigests) {
             h.write_vec3(ks);
             h.write_f32(alpha);
         }
+        Model::Dielectric { ior, alpha } => {
+            h.write_u32(2);
+            h.write_f32(ior);
+            h.write_f32(alpha);
+        }
     }
     let n = Vec3::Z;
     for uv in PROBE_UVS {

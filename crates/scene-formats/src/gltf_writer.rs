@@ -4,7 +4,8 @@
 //! - materials as metallic-roughness, emission as emissiveFactor × `KHR_materials_emissive_strength`,
 //!   `KHR_materials_specular` where the specular factor is not 1, and `extras.pbrt` where glTF
 //!   cannot say the model: `{"type": "matte", "Kd"}` for pure Lambert, `{"type": "plastic", "Kd",
-//!   "Ks", "roughness", "remaproughness": false}` for pbrt-v3 plastic;
+//!   "Ks", "roughness", "remaproughness": false}` for pbrt-v3 plastic; a rough dielectric as
+//!   `KHR_materials_transmission` (factor 1) with `KHR_materials_ior`, its tint the base colour;
 //! - sphere lights as `KHR_lights_punctual` point lights with `extras.radius` (intensity =
 //!   L·π·r², the convention of `../shared/scenes/bisml_cornell`), point, spot and directional
 //!   lights as themselves;
@@ -43,7 +44,9 @@ fn pbrt_extras(m: &Material) -> Option<Value> {
 
 fn material_json(m: &Material) -> Value {
     let (metallic, roughness) = match m.model {
-        Model::PbrtPlastic { alpha, .. } => (0.0, alpha.max(0.0).sqrt()),
+        Model::PbrtPlastic { alpha, .. } | Model::Dielectric { alpha, .. } => {
+            (0.0, alpha.max(0.0).sqrt())
+        }
         Model::MetallicRoughness => (m.metallic, m.roughness),
     };
     let b = m.base_color;
@@ -69,6 +72,13 @@ fn material_json(m: &Material) -> Value {
             "KHR_materials_specular".into(),
             json!({ "specularFactor": m.specular }),
         );
+    }
+    if let Model::Dielectric { ior, .. } = m.model {
+        ext.insert(
+            "KHR_materials_transmission".into(),
+            json!({ "transmissionFactor": 1.0 }),
+        );
+        ext.insert("KHR_materials_ior".into(), json!({ "ior": ior }));
     }
     if !ext.is_empty() {
         v["extensions"] = Value::Object(ext);
@@ -230,6 +240,13 @@ pub fn write_glb(scene: &Scene, path: &Path) -> Result<Vec<String>, SceneError> 
     let mut used = vec!["KHR_materials_emissive_strength", "KHR_materials_specular"];
     if !lights.is_empty() {
         used.push("KHR_lights_punctual");
+    }
+    if scene
+        .materials
+        .iter()
+        .any(|m| matches!(m.model, Model::Dielectric { .. }))
+    {
+        used.extend(["KHR_materials_transmission", "KHR_materials_ior"]);
     }
     let mut doc = json!({
         "asset": { "version": "2.0", "generator": "manylights convert" },

@@ -1,10 +1,12 @@
-//! Reflection BSDF at a surface point: Lambert plus a GGX lobe weighted by its Fresnel
-//! ([`Specular`]: glTF's Schlick, or pbrt-v3 `plastic`'s Ks × dielectric Fresnel).
-//! The lobes are added, not coupled.
+//! The BSDF at a surface point: Lambert plus a GGX lobe weighted by its Fresnel
+//! ([`Specular`]: glTF's Schlick, or pbrt-v3 `plastic`'s Ks × dielectric Fresnel), the lobes
+//! added, not coupled; or a rough dielectric that reflects and transmits ([`dielectric`]).
 //!
 //! Directions are in world space; the BSDF works in the local frame of the shading normal,
-//! flipped to the viewer's side. A direction below the geometric surface (as seen from the
-//! viewer) gets zero: this renderer has no transmission.
+//! flipped to the viewer's side. For the reflecting materials a direction below the geometric
+//! surface (as seen from the viewer) gets zero; the dielectric takes it as transmitted, and
+//! zero only where the geometric and the shading normal disagree on the side.
+pub mod dielectric;
 pub mod fresnel;
 pub mod microfacet;
 mod params;
@@ -26,6 +28,8 @@ pub struct Bsdf {
     pub ng: Vec3,
     pub params: BsdfParams,
     pub ggx: Ggx,
+    /// η beyond the surface over η on the viewer's side for a dielectric, 1 otherwise.
+    pub eta: f32,
 }
 
 /// f · |cos θi| and the solid-angle density of one direction.
@@ -47,6 +51,12 @@ pub struct BsdfSample {
 impl Bsdf {
     /// `ns`, `ng`: shading and geometric normals (any orientation); `wo` points away from the surface.
     pub fn new(ns: Vec3, ng: Vec3, wo: Vec3, params: BsdfParams) -> Bsdf {
+        let eta = match params.specular {
+            // the index lies behind the geometric normal: a viewer there looks out of it
+            Specular::Dielectric { ior, .. } if ng.dot(wo) < 0.0 => 1.0 / ior,
+            Specular::Dielectric { ior, .. } => ior,
+            _ => 1.0,
+        };
         let ng = if ng.dot(wo) < 0.0 { -ng } else { ng };
         let mut ns = if ns.dot(ng) < 0.0 { -ns } else { ns };
         if !ns.is_finite() || ns.length_squared() < 0.5 {
@@ -57,7 +67,15 @@ impl Bsdf {
             ng,
             params,
             ggx: Ggx::new(params.alpha),
+            eta,
         }
+    }
+
+    /// True when the BSDF transmits: light from below the surface reaches the viewer, so no
+    /// light may be culled by the receiver's hemisphere.
+    #[inline]
+    pub fn transmits(&self) -> bool {
+        matches!(self.params.specular, Specular::Dielectric { .. })
     }
 
     /// True when the specular lobe is absent (the paper skips BRDF-oriented sampling there).
@@ -144,6 +162,9 @@ impl Bsdf {
 
     /// f(wo, wi) · cos θi (shading normal).
     pub fn eval_cos(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        if self.transmits() {
+            return self.eval_dielectric(wo, wi).f_cos;
+        }
         let Some((lo, li)) = self.local_pair(wo, wi) else {
             return Vec3::ZERO;
         };
@@ -152,6 +173,9 @@ impl Bsdf {
 
     /// Solid-angle density with which [`Bsdf::sample`] picks `wi`.
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if self.transmits() {
+            return self.eval_dielectric(wo, wi).pdf;
+        }
         let Some((lo, li)) = self.local_pair(wo, wi) else {
             return 0.0;
         };
@@ -162,6 +186,9 @@ impl Bsdf {
     /// change, the half vector, D and Λ(wo) shared), bit for bit what the two give.
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> BsdfValue {
+        if self.transmits() {
+            return self.eval_dielectric(wo, wi);
+        }
         let Some((lo, li)) = self.local_pair(wo, wi) else {
             return BsdfValue {
                 f_cos: Vec3::ZERO,
@@ -180,6 +207,9 @@ impl Bsdf {
         let lo = self.frame.to_local(wo);
         if lo.z <= 0.0 || wo.dot(self.ng) <= 0.0 {
             return None;
+        }
+        if self.transmits() {
+            return self.sample_dielectric(wo, lo, u_lobe, u);
         }
         let ps = self.specular_probability(lo);
         let li = if u_lobe < ps {

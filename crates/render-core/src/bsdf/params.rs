@@ -26,6 +26,10 @@ pub enum Specular {
     Schlick { f0: Vec3 },
     /// pbrt-v3 `plastic`: Ks × pbrt-v3's `FresnelDielectric(1.5, 1)` (see [`fresnel::dielectric`]).
     PbrtPlastic { ks: Vec3 },
+    /// A rough dielectric that reflects and transmits ([`super::dielectric`]): the Fresnel
+    /// reflectance of index `ior` (inside, behind the geometric normal, over outside), and
+    /// `tint` on the transmitted light.
+    Dielectric { tint: Vec3, ior: f32 },
 }
 
 impl Specular {
@@ -36,6 +40,8 @@ impl Specular {
             Specular::None => Vec3::ZERO,
             Specular::Schlick { f0 } => fresnel::schlick(f0, cos_ih),
             Specular::PbrtPlastic { ks } => ks * fresnel::dielectric(cos_ih, 1.5, 1.0),
+            // seen from outside; the BSDF itself knows which side the viewer is on
+            Specular::Dielectric { ior, .. } => Vec3::splat(fresnel::dielectric(cos_ih, 1.0, ior)),
         }
     }
 
@@ -46,6 +52,7 @@ impl Specular {
             Specular::None => Vec3::ZERO,
             Specular::Schlick { .. } => Vec3::ONE,
             Specular::PbrtPlastic { ks } => ks,
+            Specular::Dielectric { tint, .. } => tint,
         }
     }
 
@@ -54,6 +61,8 @@ impl Specular {
             Specular::None => true,
             Specular::Schlick { f0 } => f0.max_element() <= 0.0,
             Specular::PbrtPlastic { ks } => ks.max_element() <= 0.0,
+            // reflects even when its tint blocks all transmission
+            Specular::Dielectric { .. } => false,
         }
     }
 }
@@ -70,6 +79,13 @@ impl Material {
             let s = t.sample(uv);
             roughness *= s.y;
             metallic *= s.z;
+        }
+        if let Model::Dielectric { ior, alpha } = self.model {
+            return BsdfParams {
+                diffuse: Vec3::ZERO,
+                specular: Specular::Dielectric { tint: base, ior },
+                alpha: alpha.clamp(MIN_ALPHA, 1.0),
+            };
         }
         if let Model::PbrtPlastic { ks, alpha } = self.model {
             return BsdfParams {
