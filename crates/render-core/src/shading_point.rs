@@ -26,7 +26,20 @@ impl ShadingPoint {
         self.bsdf.frame.z
     }
 
-    /// Ray origin for a ray leaving in direction `w`.
+    /// The normal by which light selection may cull what lies behind the receiver: the
+    /// geometric normal on the viewer's side, or zero where the BSDF transmits, whose lights
+    /// on both sides count (the light tree's "no receiver term").
+    #[inline]
+    pub fn cull_normal(&self) -> Vec3 {
+        if self.bsdf.transmits() {
+            Vec3::ZERO
+        } else {
+            self.bsdf.ng
+        }
+    }
+
+    /// Ray origin for a ray leaving in direction `w`: offset to the side `w` leaves on, which
+    /// is the far side for a transmitted direction.
     pub fn origin_towards(&self, w: Vec3) -> Vec3 {
         offset_origin(self.hit.point, self.hit.ng, w)
     }

@@ -159,7 +159,43 @@ impl RoughDielectric {
     }
 }
 
+/// The transmitted lobe of a rough dielectric pictured as a reflection lobe mirrored through
+/// the surface, for light-selection heuristics that have cap integrals of GGX reflection only
+/// (the BRDF-oriented importance). A direction ω below the surface is looked up as its mirror
+/// image (ωx, ωy, −ωz) in the reflection lobe seen from `view` with width `alpha`.
+///
+/// * `view` = −t, t the direction ωo refracts to through the macro-surface, so that the
+///   mirrored lobe peaks at t's mirror image, as the transmitted lobe peaks near t.
+/// * A microfacet tilted by δ turns a reflected direction by 2δ and a refracted one by about
+///   |1 − 1/η|·δ (at normal incidence), so the mirrored lobe's GGX width is α·|1 − 1/η|/2.
+/// * `weight` = tint·(1 − F(θo))/η², the smooth interface's transmitted albedo in radiance.
+///
+/// It is a heuristic only: whatever it returns, a technique that samples by it stays exact as
+/// long as it evaluates its density by the same numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MirroredTransmission {
+    pub view: Vec3,
+    pub alpha: f32,
+    pub weight: Vec3,
+}
+
 impl super::Bsdf {
+    /// [`MirroredTransmission`] of a transmitting BSDF for `lo` (local ωo); `None` when the
+    /// BSDF does not transmit or ωo meets the macro-surface beyond the critical angle.
+    pub fn mirrored_transmission(&self, lo: Vec3) -> Option<MirroredTransmission> {
+        if !self.transmits() || lo.z <= 0.0 {
+            return None;
+        }
+        let d = self.rough_dielectric();
+        let t = d.refract(lo, Vec3::Z)?;
+        let fr = d.fresnel(lo.z);
+        Some(MirroredTransmission {
+            view: -t,
+            alpha: (self.ggx.alpha * (1.0 - 1.0 / self.eta).abs() * 0.5).clamp(MIN_ALPHA, 1.0),
+            weight: self.tint() * ((1.0 - fr) / (self.eta * self.eta)),
+        })
+    }
+
     /// The dielectric lobe of a transmitting BSDF.
     #[inline]
     fn rough_dielectric(&self) -> RoughDielectric {

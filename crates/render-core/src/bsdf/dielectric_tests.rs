@@ -1,5 +1,6 @@
 use super::*;
 use crate::bsdf::Bsdf;
+use crate::bsdf::microfacet::reflect;
 use crate::rng::SampleStream;
 use chi2_test::{DirectionGrid, chi2_directions_on, sidak_significance};
 use glam::DVec3;
@@ -264,4 +265,43 @@ fn scene_checks_and_hashes_the_index() {
     assert!(err.contains("pane") && err.contains("ior"), "{err}");
     assert!(build(f32::NAN).is_err());
     assert_ne!(build(1.5).unwrap(), build(1.33).unwrap());
+}
+
+/// The mirrored transmitted lobe peaks where the transmitted samples gather, and its weight
+/// is their albedo, for a smooth pane from either side; beyond the critical angle there is none.
+#[test]
+fn mirrored_transmission_follows_the_transmitted_lobe() {
+    for (theta, ior) in [(0.5f32, 1.5f32), (1.0, 1.5), (2.7, 1.5), (0.4, 1.33)] {
+        let wo = dir(theta);
+        let b = glass(0.05, ior, wo);
+        let lo = b.frame.to_local(wo);
+        let m = b.mirrored_transmission(lo).unwrap();
+        assert!(m.view.z > 0.0 && m.alpha < b.ggx.alpha);
+        let peak = reflect(m.view, Vec3::Z) * Vec3::new(1.0, 1.0, -1.0);
+        let mut r = SampleStream::new(40, 0, 0);
+        let (mut mean, mut albedo, n) = (Vec3::ZERO, 0.0f64, 20_000);
+        for _ in 0..n {
+            if let Some(s) = b.sample(wo, r.next_f32(), r.next_2d()) {
+                let li = b.frame.to_local(s.wi);
+                if li.z < 0.0 {
+                    mean += li;
+                    albedo += (s.f_cos.x / s.pdf) as f64;
+                }
+            }
+        }
+        let mean = mean.normalize();
+        assert!(mean.dot(peak) > 0.995, "θo {theta}: {mean} vs {peak}");
+        let albedo = albedo / n as f64;
+        let want = m.weight.x as f64;
+        assert!(
+            (albedo - want).abs() < 0.03 * want,
+            "θo {theta}: {albedo} vs {want}"
+        );
+    }
+    let inside_grazing = dir(2.0);
+    let b = glass(0.05, 1.5, inside_grazing);
+    assert!(
+        b.mirrored_transmission(b.frame.to_local(inside_grazing))
+            .is_none()
+    );
 }

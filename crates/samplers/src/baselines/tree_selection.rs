@@ -147,7 +147,7 @@ impl TreeSelection {
     }
 
     fn prepare_impl(&self, sp: &ShadingPoint, cap: Option<usize>) -> TreeState {
-        let (x, n) = (sp.point(), sp.bsdf.ng);
+        let (x, n) = (sp.point(), sp.cull_normal());
         let (scratch, split) = match (&self.tree, self.mode) {
             (Some(t), TreeMode::Split(mut params)) => {
                 if let Some(cap) = cap {

@@ -46,6 +46,22 @@ pub struct BoRecord<L> {
     pub point_approx: bool,
     /// The lobe's peak, precomputed for `point_estimate` (None without a peak).
     pub(super) peak: Option<PeakBound>,
+    /// At a transmitting point, the transmitted lobe (see [`Transmitted`]).
+    pub transmitted: Option<Transmitted<L>>,
+}
+
+/// The transmitted lobe of a transmitting shading point, as the BO importance integrates it:
+/// the GGX reflection lobe of [`render_core::bsdf::dielectric::MirroredTransmission`] (a
+/// lobe around the refracted direction, mirrored above the surface), evaluated on the
+/// mirror image of the part of a cap below the surface, times `kt`, the luminance of the
+/// transmitted albedo. An approximation of ∫ f_t·|cos|; BO's density stays exact because it
+/// is evaluated from these same numbers.
+#[derive(Clone, Copy, Debug)]
+pub struct Transmitted<L> {
+    /// The mirrored reflection lobe.
+    pub lobe: L,
+    /// Luminance of the transmitted albedo that multiplies its cap integral.
+    pub kt: f32,
 }
 
 /// The lobe's peak direction and angular width w, with cos 3w and sin 3w, so that the test
@@ -149,7 +165,28 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
             kd: kd.max(0.0),
             diffuse_term,
             oat_sander,
+            transmitted: None,
         }
+    }
+
+    /// This record with the transmitted lobe of `sp` added, when its BSDF transmits (and ωo
+    /// refracts through the macro-surface); `lobe_at(view, α)` builds a reflection lobe.
+    /// The point form of the importance is turned off: it knows one lobe only.
+    pub fn with_transmission(
+        mut self,
+        sp: &ShadingPoint,
+        lobe_at: impl Fn(Vec3, f32) -> L,
+    ) -> Self {
+        let lo = sp.bsdf.frame.to_local(sp.wo);
+        if let Some(m) = sp.bsdf.mirrored_transmission(lo) {
+            self.transmitted = Some(Transmitted {
+                lobe: lobe_at(m.view, m.alpha),
+                kt: luminance(m.weight).max(0.0),
+            });
+            self.point_approx = false;
+            self.peak = None;
+        }
+        self
     }
 
     /// The record of our renderer's shading point `sp` (its BSDF gives the frame, `ks`, `kd`).
@@ -182,6 +219,9 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
         let emit = node.importance(self.x, Vec3::ZERO);
         if !(emit > 0.0) {
             return NodeTerms::default();
+        }
+        if let Some(t) = &self.transmitted {
+            return self.terms_both_sides(node, emit, t);
         }
         let to_c = node.center() - self.x;
         let d2 = to_c.length_squared();
@@ -229,6 +269,57 @@ impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
 }
 
 impl<L: LobeIntegral + LobeDensity> BoRecord<L> {
+    /// [`BoRecord::terms`] at a transmitting point: the cap's part above the surface weighed
+    /// by the reflection lobe, its part below by the mirrored transmitted lobe, both divided
+    /// by the cap's whole solid angle (so I_BO is still emitted power × the BSDF's mean over
+    /// the cap). No diffuse term: a dielectric has none.
+    fn terms_both_sides(&self, node: &Node, emit: f32, t: &Transmitted<L>) -> NodeTerms {
+        let to_c = node.center() - self.x;
+        let d2 = to_c.length_squared();
+        let r2 = node.radius() * node.radius();
+        let (ks, kt) = (self.ks, t.kt);
+        if d2 <= r2 {
+            let up = if ks > 0.0 {
+                self.lobe.hemisphere().max(0.0)
+            } else {
+                0.0
+            };
+            let down = if kt > 0.0 {
+                t.lobe.hemisphere().max(0.0)
+            } else {
+                0.0
+            };
+            return NodeTerms {
+                importance: emit * (ks * up + kt * down) / (4.0 * PI),
+                glossy: up + down,
+            };
+        }
+        let axis = self.frame.to_local(to_c / d2.sqrt()).normalize();
+        let mirrored = Vec3::new(axis.x, axis.y, -axis.z);
+        let sin2 = (r2 / d2).min(1.0);
+        let cos = (1.0 - sin2).max(0.0).sqrt();
+        let omega_up = clipped_solid_angle(axis, sin2, cos, self.oat_sander);
+        let omega_down = clipped_solid_angle(mirrored, sin2, cos, self.oat_sander);
+        let omega = omega_up.max(0.0) + omega_down.max(0.0);
+        if !(omega > 0.0) {
+            return NodeTerms::default();
+        }
+        let up = if ks > 0.0 && omega_up > 0.0 {
+            self.lobe.integral(axis, cos).max(0.0)
+        } else {
+            0.0
+        };
+        let down = if kt > 0.0 && omega_down > 0.0 {
+            t.lobe.integral(mirrored, cos).max(0.0)
+        } else {
+            0.0
+        };
+        NodeTerms {
+            importance: emit * (ks * up + kt * down) / omega,
+            glossy: up + down,
+        }
+    }
+
     /// The lobe density at the cap's axis, used instead of the closed-form cap integral
     /// (as density × |cap|) for caps wholly above the horizon that are either much narrower
     /// than the lobe or well away from its peak, with half-angle below 0.25 rad. I_BO only

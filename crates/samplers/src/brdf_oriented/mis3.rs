@@ -97,12 +97,16 @@ where
         let tree = self.ls.tree()?;
         let wo_local = sp.bsdf.frame.to_local(sp.wo);
         let lobe = self.integral.lobe(wo_local, sp.bsdf.params.alpha);
-        let pivot = if self.config.pivot_sphere {
+        // The guided point samplers follow the reflection lobe alone: a transmitting point
+        // draws its light points as every other technique does.
+        let transmits = sp.bsdf.transmits();
+        let pivot = if self.config.pivot_sphere && !transmits {
             lobe.pivot().map(|pivot| PivotSphere { pivot })
         } else {
             None
         };
-        let rec = BoRecord::new(sp, lobe, !self.config.reproduce, self.config.reproduce);
+        let rec = BoRecord::new(sp, lobe, !self.config.reproduce, self.config.reproduce)
+            .with_transmission(sp, |view, alpha| self.integral.lobe(view, alpha));
         let sg = self.sg_nodes.as_ref().map(|n| SgImportance::new(n, sp));
         Some(
             BoState::with_importance(
@@ -115,7 +119,7 @@ where
             )
             .with_four_wide_descent(self.config.four_wide_bo_descent)
             .with_light_points(scene.light_points)
-            .with_ltc_triangles(if self.config.ltc_triangles {
+            .with_ltc_triangles(if self.config.ltc_triangles && !transmits {
                 LtcTriangle::new(wo_local, sp.bsdf.params.alpha)
             } else {
                 None

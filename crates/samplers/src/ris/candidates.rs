@@ -58,7 +58,7 @@ impl<'a, L: LobeIntegral + LobeDensity> CandidateSource<'a, L> {
             scene,
             tree,
             x: sp.point(),
-            n: sp.bsdf.ng,
+            n: sp.cull_normal(),
             ns: sp.normal(),
             memo: RefCell::new(Pooled::take()),
             bo,

@@ -96,7 +96,8 @@ where
         let lobe = self
             .integral
             .lobe(sp.bsdf.frame.to_local(sp.wo), sp.bsdf.params.alpha);
-        let rec = BoRecord::new(sp, lobe, true, false);
+        let rec = BoRecord::new(sp, lobe, true, false)
+            .with_transmission(sp, |view, alpha| self.integral.lobe(view, alpha));
         Some(
             BoState::new(tree, rec, self.delta, self.max_cut, None)
                 .with_light_points(scene.light_points),

@@ -212,7 +212,7 @@ impl Rht {
         let bo = self.bo.as_ref().and_then(|i| BoWeight::at(sp, i));
         match bo {
             Some(b) => NodeWeights::Bo(b),
-            None => NodeWeights::Tree(sp.point(), sp.bsdf.ng),
+            None => NodeWeights::Tree(sp.point(), sp.cull_normal()),
         }
     }
 

@@ -292,7 +292,7 @@ impl LightSelection for SlcSelection {
     type State = SlcState;
 
     fn prepare(&self, _: &Scene, sp: &ShadingPoint) -> SlcState {
-        let (x, n) = (sp.point(), sp.bsdf.ng);
+        let (x, n) = (sp.point(), sp.cull_normal());
         let scratch = self.tree.as_ref().map(|tree| {
             let mut s = Pooled::<SlcScratch>::take();
             let SlcScratch { cut, heap } = &mut *s;

@@ -47,12 +47,13 @@ impl BoWeight {
             return None;
         }
         let lobe = integral.lobe(sp.bsdf.frame.to_local(sp.wo), sp.bsdf.params.alpha);
-        let rec = BoRecord::new(sp, lobe, true, false);
+        let rec = BoRecord::new(sp, lobe, true, false)
+            .with_transmission(sp, |view, alpha| integral.lobe(view, alpha));
         // Any positive floor keeps the estimator complete; a dark lobe keeps a tiny one.
-        let albedo = (rec.ks + rec.kd).max(1e-3);
+        let albedo = (rec.ks + rec.kd + rec.transmitted.as_ref().map_or(0.0, |t| t.kt)).max(1e-3);
         Some(BoWeight {
             rec,
-            n: sp.bsdf.ng,
+            n: sp.cull_normal(),
             floor: EK_FLOOR * albedo / PI,
         })
     }

@@ -118,7 +118,7 @@ impl VarlSelection {
 
     /// The state at `sp` under `table`.
     pub fn prepare_with(&self, sp: &ShadingPoint, table: &VarlTable) -> VarlState {
-        let (x, n) = (sp.point(), sp.bsdf.ng);
+        let (x, n) = (sp.point(), sp.cull_normal());
         let key = self.grid.key(x, n);
         let mut s = VarlState {
             key,

@@ -75,7 +75,7 @@ impl SgShading {
         let rho = luminance(bsdf.params.diffuse) + luminance(bsdf.glossy_weight(wo));
         SgShading {
             x: sp.point(),
-            ng: bsdf.ng,
+            ng: sp.cull_normal(),
             frame,
             wo,
             kd: luminance(bsdf.params.diffuse) / PI,
