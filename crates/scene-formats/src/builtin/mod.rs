@@ -10,6 +10,7 @@ mod car;
 mod cornell;
 mod diffuse_quads;
 mod emissive_mesh;
+mod frosted_panel;
 mod glossy_spheres;
 mod grid;
 mod lamp;
@@ -102,6 +103,26 @@ const SCENES: &[Def] = &[
             key("seed", "0", SEED_HELP),
         ],
         build: emissive_mesh::build,
+    },
+    Def {
+        name: "frosted-panel",
+        description: "a frosted-glass pane (rough dielectric) lit from behind by many small two-sided emissive triangles, a diffuse sphere and a glossy box in front, a few lights above the camera",
+        keys: &[
+            key(
+                "lights",
+                "1000",
+                "number of emissive triangles (9 in 10 behind the pane)",
+            ),
+            key("frost", "0.2", "GGX alpha of the pane, in [0.001, 1]"),
+            key(
+                "ior",
+                "1.5",
+                "index of refraction of the pane, in [1.01, 3]",
+            ),
+            key("roughness", "0.3", ROUGHNESS_HELP),
+            key("seed", "0", SEED_HELP),
+        ],
+        build: frosted_panel::build,
     },
     Def {
         name: "car",
@@ -305,6 +326,12 @@ impl Params {
                 }
                 "subdivisions" => {
                     params.count("subdivisions", 0, 3)?;
+                }
+                "frost" => {
+                    params.number("frost", 1e-3, 1.0)?;
+                }
+                "ior" => {
+                    params.number("ior", 1.01, 3.0)?;
                 }
                 _ => {}
             }

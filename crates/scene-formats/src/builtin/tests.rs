@@ -475,3 +475,38 @@ fn rooms_hide_most_lights_from_the_camera() {
     let share = visible as f32 / 3000.0;
     assert!(share > 0.05 && share < 0.35, "visible share {share}");
 }
+
+/// The pane is a rough dielectric facing the camera, 9 lights in 10 lie behind it, and the
+/// keys reach the material.
+#[test]
+fn frosted_panel_is_lit_from_behind() {
+    use render_core::material::Model;
+    let s = load_builtin("builtin:frosted-panel?lights=400&frost=0.3&ior=1.4").unwrap();
+    assert_eq!(lights_of(&s), 400);
+    let behind = s.lights.iter().filter(|l| l.bounds().1.z < 0.0).count();
+    assert_eq!(behind, 360);
+    let glass: Vec<_> = s
+        .materials
+        .iter()
+        .filter(|m| matches!(m.model, Model::Dielectric { .. }))
+        .collect();
+    assert_eq!(glass.len(), 1);
+    assert_eq!(
+        glass[0].model,
+        Model::Dielectric {
+            ior: 1.4,
+            alpha: 0.3
+        }
+    );
+    let cam = s.camera(None).unwrap();
+    let hit = s
+        .intersect(cam.position, cam.forward, 0.0, f32::INFINITY)
+        .unwrap();
+    assert!(s.materials[hit.material.unwrap() as usize].model == glass[0].model);
+    for bad in ["ior=1", "ior=1.005", "frost=0", "frost=2"] {
+        assert!(
+            load_builtin(&format!("builtin:frosted-panel?{bad}")).is_err(),
+            "{bad}"
+        );
+    }
+}
