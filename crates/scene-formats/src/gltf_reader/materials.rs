@@ -1,10 +1,12 @@
 //! glTF materials → [`Material`]s: metallic-roughness factors and textures, the specular and
-//! emissive-strength extensions, and a material's `extras.pbrt`; what is not modelled is a
-//! warning.
+//! emissive-strength extensions, transmission (with `KHR_materials_ior`) as the rough
+//! dielectric, and a material's `extras.pbrt`; what is not modelled is a warning.
 use super::{Loader, UvSpec};
 use glam::Vec3;
+use render_core::bsdf::dielectric;
+use render_core::bsdf::microfacet::MIN_ALPHA;
 use render_core::error::SceneError;
-use render_core::material::Material;
+use render_core::material::{Material, Model};
 
 impl Loader<'_> {
     /// The builder material of a glTF material, created on first use.
@@ -65,15 +67,12 @@ impl Loader<'_> {
                     });
                 }
                 for (ext, what) in [
-                    ("KHR_materials_transmission", "transmission"),
                     ("KHR_materials_clearcoat", "clearcoat"),
                     ("KHR_materials_sheen", "sheen"),
                     ("KHR_materials_volume", "volume"),
                     ("KHR_materials_pbrSpecularGlossiness", "specular-glossiness"),
                 ] {
-                    if m.extension_value(ext).is_some()
-                        || (ext == "KHR_materials_transmission" && m.transmission().is_some())
-                    {
+                    if m.extension_value(ext).is_some() {
                         self.report.warn(format!(
                             "material `{name}`: {what} ignored (read as opaque metallic-roughness)"
                         ));
@@ -91,6 +90,7 @@ impl Loader<'_> {
                         "material `{name}`: specular texture and colour ignored (factor used)"
                     ));
                 }
+                let model = self.transmission_model(&m, &name)?;
                 let gltf_material = Material {
                     name,
                     base_color: Vec3::new(bc[0], bc[1], bc[2]),
@@ -102,7 +102,7 @@ impl Loader<'_> {
                     double_sided: m.double_sided(),
                     emission,
                     emission_texture,
-                    model: Default::default(),
+                    model,
                 };
                 match crate::gltf_reader::pbrt_extras::material(gltf_material, m.extras()) {
                     Ok(mat) => mat,
@@ -116,5 +116,54 @@ impl Loader<'_> {
         let id = self.builder.add_material(mat)?;
         self.materials.insert(m.index(), (id, uv));
         Ok((id, uv))
+    }
+
+    /// `KHR_materials_transmission` with a factor above 0 makes the rough dielectric: ior from
+    /// `KHR_materials_ior` (1.5 by default), α = roughness², the base colour as the tint. A
+    /// partial factor, a transmission texture, metalness and `KHR_materials_volume` (a thick
+    /// medium) are not modelled: a warning each, and the surface is one thin interface.
+    fn transmission_model(&mut self, m: &gltf::Material, name: &str) -> Result<Model, SceneError> {
+        let volume = m.extension_value("KHR_materials_volume").is_some();
+        let Some(t) = m.transmission().filter(|t| t.transmission_factor() > 0.0) else {
+            if volume {
+                self.report.warn(format!(
+                    "material `{name}`: volume ignored (no transmission)"
+                ));
+            }
+            return Ok(Model::MetallicRoughness);
+        };
+        let mut ignored = Vec::new();
+        if t.transmission_factor() < 1.0 {
+            ignored.push(format!(
+                "transmission factor {} (read as 1)",
+                t.transmission_factor()
+            ));
+        }
+        if t.transmission_texture().is_some() {
+            ignored.push("transmission texture".into());
+        }
+        let pbr = m.pbr_metallic_roughness();
+        if pbr.metallic_factor() > 0.0 || pbr.metallic_roughness_texture().is_some() {
+            ignored.push("metalness and the metallic-roughness texture".into());
+        }
+        if volume {
+            ignored.push("volume (read as a thin interface)".into());
+        }
+        if !ignored.is_empty() {
+            self.report.warn(format!(
+                "material `{name}`: transmission as a rough dielectric; ignored: {}",
+                ignored.join(", ")
+            ));
+        }
+        let ior = m.ior().unwrap_or(1.5);
+        dielectric::check_ior(ior).map_err(|message| SceneError::BadMaterial {
+            name: name.into(),
+            message,
+        })?;
+        let r = pbr.roughness_factor();
+        Ok(Model::Dielectric {
+            ior,
+            alpha: (r * r).clamp(MIN_ALPHA, 1.0),
+        })
     }
 }

@@ -6,13 +6,14 @@
 //! | `plastic` (v3): `Kd`, `Ks`, `roughness`, `remaproughness` | pbrt-v3's plastic ([`render_core::bsdf::plastic`]) |
 //! | `coateddiffuse` (v4): `reflectance`, `roughness`, `remaproughness` | the glTF dielectric (Lambert + GGX, Schlick F0 = 0.04), with a warning |
 //! | `conductor` (v4), `metal` (v3): `reflectance`, or `eta` + `k`, `roughness` | the glTF metal, F0 = reflectance or the normal-incidence Fresnel of η + ik |
-//! | `dielectric` (v4), `glass` (v3): `eta`, `roughness` | an opaque black dielectric coat (F0 = ((η−1)/(η+1))²), with a warning |
+//! | `dielectric` (v4), `glass` (v3): `eta` (`index`), `roughness` or `uroughness`/`vroughness`, `remaproughness`; v3's `Kt` | the rough dielectric ([`render_core::bsdf::dielectric`]): ior = η, α = √roughness (v4's remap) or pbrt-v3's polynomial (`glass`), tint = `Kt` |
+//! | `thindielectric` (v4): `eta` | an opaque black dielectric coat (F0 = ((η−1)/(η+1))²), with a warning |
 //! | anything else | `matte` 0.5, with a warning |
 //!
 //! Parameters may name a texture; constant textures are used as their value, any other
 //! texture as the parameter's default, with a warning.
 use glam::Vec3;
-use render_core::bsdf::plastic;
+use render_core::bsdf::{dielectric, plastic};
 use render_core::material::Material;
 use std::collections::HashMap;
 
@@ -118,6 +119,21 @@ pub fn texture(class: &str, p: &ParamList, ctx: &mut Context) -> Result<TextureV
 /// pbrt's roughness parameters: `roughness` (or the mean of `uroughness`/`vroughness`),
 /// remapped by pbrt's `RoughnessToAlpha` when `remaproughness` (default true).
 fn alpha(p: &ParamList, ctx: &mut Context, default: f32) -> Result<f32, String> {
+    alpha_remapped(p, ctx, default, plastic::roughness_to_alpha)
+}
+
+/// pbrt-v4's `RoughnessToAlpha`: √roughness.
+fn v4_roughness_to_alpha(roughness: f32) -> f32 {
+    roughness.max(0.0).sqrt()
+}
+
+/// [`alpha`] with the remapping `remap` (pbrt-v3's and pbrt-v4's differ).
+fn alpha_remapped(
+    p: &ParamList,
+    ctx: &mut Context,
+    default: f32,
+    remap: fn(f32) -> f32,
+) -> Result<f32, String> {
     let r = if p.has("roughness") {
         ctx.float(p, "roughness", default)?
     } else if p.has("uroughness") || p.has("vroughness") {
@@ -132,7 +148,7 @@ fn alpha(p: &ParamList, ctx: &mut Context, default: f32) -> Result<f32, String> 
         default
     };
     Ok(if p.bool("remaproughness", true)? {
-        plastic::roughness_to_alpha(r)
+        remap(r)
     } else {
         r
     })
@@ -204,13 +220,24 @@ pub fn material(
             };
             gltf_like(name, f0.clamp(Vec3::ZERO, Vec3::ONE), 1.0, a, 1.0)
         }
-        "dielectric" | "glass" | "thindielectric" => {
-            let eta = ctx.float(p, "eta", 1.5)?;
-            let eta = if p.has("index") {
-                ctx.float(p, "index", eta)?
+        "dielectric" | "glass" => {
+            let eta = index_of_refraction(p, ctx)?;
+            dielectric::check_ior(eta).map_err(|e| format!("{kind}: {e}"))?;
+            let a = if kind == "glass" {
+                alpha(p, ctx, 0.0)?
             } else {
-                eta
+                alpha_remapped(p, ctx, 0.0, v4_roughness_to_alpha)?
             };
+            let tint = ctx.colour(p, "Kt", Vec3::ONE)?;
+            if ctx.colour(p, "Kr", Vec3::ONE)? != Vec3::ONE {
+                ctx.warnings.push(format!(
+                    "{kind} `Kr` ignored (reflection is the Fresnel term's)"
+                ));
+            }
+            dielectric::material(name, tint, eta, a)
+        }
+        "thindielectric" => {
+            let eta = index_of_refraction(p, ctx)?;
             let a = alpha(p, ctx, 0.0)?;
             for k in ["Kr", "Kt"] {
                 p.touch(k);
@@ -232,6 +259,16 @@ pub fn material(
         }
     };
     Ok(Some(m))
+}
+
+/// A dielectric's `eta` (pbrt-v3's `index` where given), 1.5 by default.
+fn index_of_refraction(p: &ParamList, ctx: &mut Context) -> Result<f32, String> {
+    let eta = ctx.float(p, "eta", 1.5)?;
+    if p.has("index") {
+        ctx.float(p, "index", eta)
+    } else {
+        Ok(eta)
+    }
 }
 
 /// The default material before any `Material` directive (pbrt's: matte 0.5).
