@@ -236,6 +236,13 @@ fn hash_material(h: &mut ContentHasher, m: &Material, d: &mut TextureDigests) {
                 let f = bsdf.eval_cos(wo, wi);
                 f.to_array().iter().for_each(|&x| h.write_u32(coarse(x)));
                 h.write_u32(coarse(bsdf.pdf(wo, wi)));
+                if bsdf.transmits() {
+                    // and the transmitted direction below it, for the materials that have one
+                    let wt = wi * Vec3::new(1.0, 1.0, -1.0);
+                    let f = bsdf.eval_cos(wo, wt);
+                    f.to_array().iter().for_each(|&x| h.write_u32(coarse(x)));
+                    h.write_u32(coarse(bsdf.pdf(wo, wt)));
+                }
             }
         }
     }

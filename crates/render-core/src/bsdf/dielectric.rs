@@ -35,10 +35,17 @@ pub fn material(name: &str, tint: Vec3, ior: f32, alpha: f32) -> Material {
     }
 }
 
+/// The range of indices of refraction accepted (beyond it 1/ior and η² leave f32's range
+/// in the BSDF's arithmetic; real materials lie far inside).
+pub const IOR_RANGE: (f32, f32) = (0.01, 100.0);
+
 /// Why an index of refraction cannot be used, if it cannot.
 pub fn check_ior(ior: f32) -> Result<(), String> {
-    if !ior.is_finite() || ior <= 0.0 {
-        return Err(format!("ior {ior} must be finite and positive"));
+    if !(IOR_RANGE.0..=IOR_RANGE.1).contains(&ior) {
+        return Err(format!(
+            "ior {ior} is outside [{}, {}]",
+            IOR_RANGE.0, IOR_RANGE.1
+        ));
     }
     if (ior - 1.0).abs() < MIN_IOR_GAP {
         return Err(format!(
@@ -194,6 +201,11 @@ impl super::Bsdf {
             alpha: (self.ggx.alpha * (1.0 - 1.0 / self.eta).abs() * 0.5).clamp(MIN_ALPHA, 1.0),
             weight: self.tint() * ((1.0 - fr) / (self.eta * self.eta)),
         })
+    }
+
+    /// The Fresnel reflectance of a dielectric for the viewer at cos θ = `cos_o` to a microfacet.
+    pub fn reflectance(&self, cos_o: f32) -> f32 {
+        self.rough_dielectric().fresnel(cos_o)
     }
 
     /// The dielectric lobe of a transmitting BSDF.

@@ -221,7 +221,7 @@ fn white_furnace() {
 #[test]
 fn ior_near_one_or_invalid_is_refused() {
     assert!(check_ior(1.5).is_ok() && check_ior(0.7).is_ok());
-    for bad in [1.0, 1.0005, 0.0, -1.5, f32::NAN, f32::INFINITY] {
+    for bad in [1.0, 1.0005, 0.0, -1.5, 1e-30, 1e30, f32::NAN, f32::INFINITY] {
         assert!(check_ior(bad).is_err(), "{bad}");
     }
 }
@@ -304,4 +304,19 @@ fn mirrored_transmission_follows_the_transmitted_lobe() {
         b.mirrored_transmission(b.frame.to_local(inside_grazing))
             .is_none()
     );
+}
+
+/// The glossy weight (the BO importance's reflection weight) is the Fresnel reflectance seen
+/// from the viewer's side: 0.04 head-on from either side, total reflection past the critical
+/// angle from inside.
+#[test]
+fn glossy_weight_is_the_reflectance_from_the_viewers_side() {
+    let weight = |theta: f32| {
+        let b = glass(0.1, 1.5, dir(theta));
+        b.glossy_weight(b.frame.to_local(dir(theta))).x
+    };
+    assert!((weight(0.0) - 0.04).abs() < 1e-5);
+    assert!((weight(std::f32::consts::PI) - 0.04).abs() < 1e-5);
+    assert_eq!(weight(std::f32::consts::PI - 1.0), 1.0);
+    assert!(weight(1.0) < 0.1);
 }

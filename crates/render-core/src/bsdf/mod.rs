@@ -84,10 +84,14 @@ impl Bsdf {
     }
 
     /// The glossy lobe's weight where it peaks, in the mirror configuration (half vector =
-    /// normal, so ωi makes θo with it): the Fresnel-weighted colour the lobe reflects with.
+    /// normal, so ωi makes θo with it): the Fresnel-weighted colour the lobe reflects with
+    /// (for a dielectric, from the side the viewer is on).
     pub fn glossy_weight(&self, wo_local: Vec3) -> Vec3 {
         if self.is_pure_diffuse() {
             return Vec3::ZERO;
+        }
+        if self.transmits() {
+            return Vec3::splat(self.reflectance(wo_local.z));
         }
         self.params.specular.weight(wo_local.z)
     }
