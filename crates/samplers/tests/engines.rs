@@ -1,7 +1,8 @@
 //! The batched engine (`render_core::batch`) against the per-sample one: every registered
 //! strategy renders the same image bit for bit, with the same counters, in both engines and
 //! for one and two threads, on a scene with triangle, sphere, point and distant lights, under
-//! the sampled reconstruction with extra emission rays and under splatting. The light
+//! the sampled reconstruction with extra emission rays and under splatting, and on a rough
+//! dielectric pane lit from behind (light through a transmitting surface). The light
 //! strategies must actually run batched (a strategy that silently fell back to the per-sample
 //! path would pass the equality without testing anything).
 mod common;
@@ -69,7 +70,11 @@ fn same(a: &RenderResult, b: &RenderResult, what: &str) {
 fn every_strategy_renders_the_same_image_in_both_engines() {
     let scene = scene();
     let mut batched = Vec::new();
+    let pane = scene_formats::load_scene("builtin:frosted-panel?lights=60", None).unwrap();
     for s in samplers::registry::STRATEGIES {
+        let per_sample = render_with(&pane, s.name, Engine::PerSample, 1, Reconstruction::Sampled);
+        let b = render_with(&pane, s.name, Engine::Batched, 2, Reconstruction::Sampled);
+        same(&per_sample, &b, &format!("{} (frosted panel)", s.name));
         let strategy = samplers::create(s.name, &scene, &StrategyOptions::default()).unwrap();
         if Engine::Batched.used_for(strategy.as_ref()) == "batched" {
             batched.push(s.name);

@@ -114,6 +114,7 @@ fn render_uniform(scene: &Scene, cull_behind: bool) -> RenderResult {
         filter: Default::default(),
         reconstruction: Default::default(),
         emission_rays: Default::default(),
+        engine: Default::default(),
     };
     render(
         scene,
