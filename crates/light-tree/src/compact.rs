@@ -180,6 +180,44 @@ impl Slots<4> for TwoPairs<'_> {
     }
 }
 
+/// Four pairs as eight slots, pair k in lanes 2k and 2k + 1.
+pub(crate) struct FourPairs<'a>(pub(crate) [&'a NodePair; 4]);
+
+impl FourPairs<'_> {
+    #[inline(always)]
+    fn join<T: Copy>(&self, f: impl Fn(&NodePair) -> [T; 2]) -> [T; 8] {
+        let [a, b, c, d] = self.0.map(f);
+        [a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1]]
+    }
+}
+
+impl Slots<8> for FourPairs<'_> {
+    #[inline(always)]
+    fn qbox(&self, k: usize) -> [u16; 8] {
+        self.join(|p| p.qbox[k])
+    }
+    #[inline(always)]
+    fn axis(&self, k: usize) -> [i16; 8] {
+        self.join(|p| p.axis[k])
+    }
+    #[inline(always)]
+    fn cos_o(&self) -> [i16; 8] {
+        self.join(|p| p.cos_o)
+    }
+    #[inline(always)]
+    fn cos_e(&self) -> [i16; 8] {
+        self.join(|p| p.cos_e)
+    }
+    #[inline(always)]
+    fn power(&self) -> [f32; 8] {
+        self.join(|p| p.power)
+    }
+    #[inline(always)]
+    fn flags(&self) -> [u8; 8] {
+        self.join(|p| p.flags)
+    }
+}
+
 /// The compact importances of two pairs at once, `[a.left, a.right, b.left, b.right]`.
 #[inline(always)]
 pub(crate) fn quad_importance<L: Lanes<4>>(
@@ -225,6 +263,87 @@ impl LightTree {
         let s = self.compact.slot_of[node as usize];
         let code = self.compact.pairs[(s >> 1) as usize].child[(s & 1) as usize];
         (code & LEAF_BIT == 0).then_some(code)
+    }
+
+    /// The pair that holds `node`'s children (`None` for a leaf), for callers that keep it
+    /// beside their own per-node data and skip the two lookups of
+    /// [`LightTree::child_importances`].
+    #[inline]
+    pub fn children_pair_of(&self, node: u32) -> Option<u32> {
+        self.children_pair(node)
+    }
+
+    /// [`LightTree::child_importances`] of the node whose children pair `pair` holds (from
+    /// [`LightTree::children_pair_of`]): the same bits.
+    #[inline]
+    pub fn pair_child_importances(&self, pair: u32, x: Vec3, n: Vec3) -> [f32; 2] {
+        self.pair_importances(pair, x, n)
+    }
+
+    /// [`LightTree::pair_child_importances`] of `pair` and, from the same eight-lane pass
+    /// (one AVX2 pass where the CPU has it, two four-lane ones otherwise), of the pairs below
+    /// it: the children's importances of each of `pair`'s two nodes, `None` for a leaf. A
+    /// descent that takes one child at a time evaluates every other level; the values are
+    /// the same bits as one call per pair.
+    pub fn pair_child_importances_ahead(
+        &self,
+        pair: u32,
+        x: Vec3,
+        n: Vec3,
+    ) -> ([f32; 2], [Option<[f32; 2]>; 2]) {
+        let c = &self.compact;
+        let p = &c.pairs[pair as usize];
+        // A leaf's lanes hold a copy of `pair` (valid bounds, discarded).
+        let below = p.child.map(|code| (code & LEAF_BIT == 0).then_some(code));
+        let slots = FourPairs([
+            p,
+            below[0].map_or(p, |q| &c.pairs[q as usize]),
+            below[1].map_or(p, |q| &c.pairs[q as usize]),
+            p,
+        ]);
+        let v = self.eight_lanes(&slots, x, n);
+        let lanes = |k: usize| [v[2 * k], v[2 * k + 1]];
+        (
+            lanes(0),
+            [below[0].map(|_| lanes(1)), below[1].map(|_| lanes(2))],
+        )
+    }
+
+    /// The compact importances of eight slots on the best lanes.
+    #[inline(always)]
+    fn eight_lanes(&self, slots: &FourPairs<'_>, x: Vec3, n: Vec3) -> [f32; 8] {
+        #[cfg(target_arch = "x86_64")]
+        if self.compact.simd == DescentSimd::Avx2 {
+            // SAFETY: `simd` is `Avx2` only where the CPU was found to have AVX2.
+            return unsafe { self.eight_lanes_avx2(slots, x, n) };
+        }
+        slots_importance::<8, crate::lanes::Fast8, _>(slots, &self.compact.quant, x, n)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    unsafe fn eight_lanes_avx2(&self, slots: &FourPairs<'_>, x: Vec3, n: Vec3) -> [f32; 8] {
+        slots_importance::<8, crate::lanes::Avx8, _>(slots, &self.compact.quant, x, n)
+    }
+
+    /// Starts loading the pairs of the grandchildren under pair `pair` (the next step of a
+    /// descent, whichever child it takes), so that their cache misses overlap the work on
+    /// `pair` itself (a hint).
+    #[inline(always)]
+    pub fn prefetch_next_pairs(&self, pair: u32) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(p) = self.compact.pairs.get(pair as usize) {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            let base = self.compact.pairs.as_ptr();
+            for code in p.child {
+                if code & LEAF_BIT == 0 {
+                    // SAFETY: a prefetch never faults; interior codes are valid pair indices.
+                    unsafe { _mm_prefetch::<_MM_HINT_T0>(base.add(code as usize) as *const i8) };
+                }
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = pair;
     }
 }
 

@@ -497,3 +497,52 @@ fn caller_weighted_quad_descent_matches_the_generic_one() {
         }
     }
 }
+
+/// The pair handle gives `child_importances`, bit for bit, for every interior node, and no pair
+/// for a leaf.
+#[test]
+fn pair_child_importances_match_child_importances() {
+    let mut rng = Pcg32::seed_from_u64(46);
+    for (tree, _) in trees(&mut rng) {
+        for _ in 0..10 {
+            let (x, n) = rand_receiver(&mut rng);
+            for id in 0..tree.nodes().len() as NodeId {
+                let Some(pair) = tree.children_pair_of(id) else {
+                    assert!(tree.node(id).is_leaf(), "node {id}");
+                    continue;
+                };
+                let want = tree.child_importances(id, x, n).unwrap();
+                let got = tree.pair_child_importances(pair, x, n);
+                assert_eq!(got.map(f32::to_bits), want.map(f32::to_bits), "node {id}");
+            }
+        }
+    }
+}
+
+/// The eight-lane look-ahead gives each pair's `pair_child_importances`, bit for bit, on both
+/// kinds of lanes, and `None` below a leaf.
+#[test]
+fn pair_child_importances_ahead_match_one_call_per_pair() {
+    let mut rng = Pcg32::seed_from_u64(47);
+    for (mut tree, _) in trees(&mut rng) {
+        for simd in [DescentSimd::Fallback, DescentSimd::detect()] {
+            tree.set_descent_simd(simd).unwrap();
+            for _ in 0..10 {
+                let (x, n) = rand_receiver(&mut rng);
+                for id in 0..tree.nodes().len() as NodeId {
+                    let Some(pair) = tree.children_pair_of(id) else {
+                        continue;
+                    };
+                    let (own, below) = tree.pair_child_importances_ahead(pair, x, n);
+                    let bits = |v: [f32; 2]| v.map(f32::to_bits);
+                    assert_eq!(bits(own), bits(tree.pair_child_importances(pair, x, n)));
+                    let (l, r) = tree.node(id).children(id).unwrap();
+                    for (child, got) in [l, r].into_iter().zip(below) {
+                        let want = tree.child_importances(child, x, n);
+                        assert_eq!(got.map(bits), want.map(bits), "node {id}, child {child}");
+                    }
+                }
+            }
+        }
+    }
+}
