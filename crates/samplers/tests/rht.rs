@@ -1,7 +1,7 @@
 //! The resampled hierarchical tree (issue 50, `rivals/rht.rs`): each light's gathering
-//! frequency against its probability π (chi-square), π at gathering against its replay, the
-//! biased traversal caught and the corrected one not on a scene with an exact answer,
-//! convergence to `power+bsdf`'s image, thread-count determinism.
+//! frequency against its probability π (chi-square), π and the single-descent pmf at gathering
+//! against their replays, the biased traversal caught and the corrected one not on a scene
+//! with an exact answer, convergence to `power+bsdf`'s image, thread-count determinism.
 mod common;
 use chi2_test::{chi2_test, sidak_significance};
 use render_core::Vec3;
@@ -99,11 +99,15 @@ fn each_light_is_gathered_with_its_probability_chi2_and_pi_replays() {
                 let mut rng = SampleStream::new(3 + p as u64, 0, i);
                 let gathered = strategy.gather(sp, &mut rng);
                 total += gathered.len();
-                for &(l, pi) in &gathered {
-                    let (replayed, descent) = strategy.inclusion(sp, l);
-                    assert_eq!(pi.to_bits(), replayed.to_bits());
-                    assert_eq!(descent.to_bits(), strategy.descent_pmf(sp, l).to_bits());
-                    counts[l as usize] += 1.0;
+                for g in &gathered {
+                    let (replayed, descent) = strategy.inclusion(sp, g.light);
+                    assert_eq!(g.pi.to_bits(), replayed.to_bits());
+                    assert_eq!(
+                        descent.to_bits(),
+                        strategy.descent_pmf(sp, g.light).to_bits()
+                    );
+                    assert_eq!(g.descent.to_bits(), descent.to_bits());
+                    counts[g.light as usize] += 1.0;
                 }
             }
             eprintln!(

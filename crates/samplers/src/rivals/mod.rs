@@ -6,13 +6,15 @@
 //! * [`slc_bo`]: `slc-bo+bsdf`, its descent weighed by the paper's BRDF-oriented importance.
 //! * [`slc_minmax`]: the descent of Lin & Yuksel's real-time code, as an option of `slc`.
 //! * [`rht`]: the resampled hierarchical tree (Conty Estevez, Hellmuth & Lecocq 2024): a
-//!   stochastic split traversal gathers candidates ([`rht_gather`]), one resampled to shade.
+//!   stochastic split traversal gathers candidates ([`rht_gather`], over the records of
+//!   [`rht_nodes`]), one resampled to shade.
 //! * [`varl`]: learning to cluster (Wang, Wu, Li & Chuang 2021): per region a cut refined and a
 //!   distribution over it learnt between passes ([`varl_table`]).
 //!
 //! Their knobs live apart ([`rht_options`], [`varl_options`]), as leaves the shared options import.
 pub mod rht;
 pub mod rht_gather;
+pub mod rht_nodes;
 pub mod rht_options;
 pub mod slc;
 pub mod slc_bo;

@@ -18,6 +18,19 @@
 //! expectation over the set and the points is ∫ f wherever π·p_pt > 0 (Horvitz–Thompson): the
 //! gathering probability must be π, not an approximation of it ([`RhtTraversal`]).
 //!
+//! # What we follow
+//!
+//! The talk (doi:10.1145/3641233.3664352) was not among the sources we could read, nor the
+//! 2026 study's corrected traversal; what we follow is the description (stochastic
+//! splitting gathers candidates, reservoir resampling by unshadowed contribution keeps one or
+//! a few, the published traversal probability darkens the image) and our own derivation of an
+//! unbiased form. The one public reading of the talk's split measure we found (the Luminary
+//! renderer, which credits it) makes the split probability a function of the node's distance
+//! d over its spatial spread r, 1/(1 + t²/a) with t = max(d − r, 0)/r and a a constant,
+//! compared against one random number shared by all the nodes of a traversal; ours is also a
+//! function of d/r (and of the spread of the node's powers) but drawn independently per node,
+//! so that π has a closed form. docs/notes/rivals.md lists the sources and their addresses.
+//!
 //! # Parameters (defaults, and where we differ from the talk)
 //!
 //! * `--rht-tau` τ = [`DEFAULT_TAU`]: a node splits with probability clamp(1 − ρ/τ, 0, 1), ρ
@@ -42,7 +55,8 @@
 //! sampling cannot hit). w_R is a fixed function of y and the shading point, so w_R·f is a
 //! valid RIS integrand; where P_D > 0 every step on ℓ's path has q ≥ p > 0, so π > 0 and the
 //! candidates cover every y with w_R(y) > 0; elsewhere w_R = 0 and BSDF sampling takes it all.
-use super::rht_gather::Traversal;
+use super::rht_gather::{Gathered, Traversal, Visit};
+use super::rht_nodes::{RhtNodes, zero_split_bound};
 pub use super::rht_options::{DEFAULT_PICKS, DEFAULT_TAU, MAX_PICKS, RhtOptions, RhtTraversal};
 use super::slc_bo::BoWeight;
 use crate::bsdf_sampling::sample_bsdf;
@@ -139,7 +153,8 @@ pub fn resolved_parameters(config: &RhtConfig) -> serde_json::Value {
 
 /// A gathered candidate with its light point and target.
 struct Candidate {
-    light: u32,
+    /// Its single-descent pmf, for the MIS weight.
+    descent: f32,
     sample: LightSample,
     target: f32,
 }
@@ -147,8 +162,8 @@ struct Candidate {
 /// Per-thread buffers of one shading point.
 #[derive(Default)]
 struct RhtScratch {
-    stack: Vec<(NodeId, f32)>,
-    gathered: Vec<(u32, f32)>,
+    stack: Vec<Visit>,
+    gathered: Vec<Gathered>,
     candidates: Vec<Candidate>,
     weights: Vec<f32>,
 }
@@ -169,14 +184,30 @@ pub enum NodeWeights {
 }
 
 impl NodeWeights {
-    /// The weights of the two children of interior node `id`.
-    pub fn children(&self, tree: &LightTree, id: NodeId) -> [f32; 2] {
+    /// The weights of the two children of interior node `id`, whose compact pair is `pair`.
+    pub fn children(&self, tree: &LightTree, id: NodeId, pair: u32) -> [f32; 2] {
         match self {
-            NodeWeights::Tree(x, n) => tree.child_importances(id, *x, *n).unwrap_or([0.0; 2]),
+            NodeWeights::Tree(x, n) => tree.pair_child_importances(pair, *x, *n),
             NodeWeights::Bo(bo) => match tree.node(id).children(id) {
                 Some((l, r)) => [bo.weight(tree.node(l)), bo.weight(tree.node(r))],
                 None => [0.0; 2],
             },
+        }
+    }
+
+    /// [`NodeWeights::children`] and, where one evaluation gives them at no extra cost (the
+    /// tree's importance, eight lanes at a time), the weights of the children's own children
+    /// (`None` for a leaf or where not evaluated).
+    #[inline]
+    pub fn children_ahead(
+        &self,
+        tree: &LightTree,
+        id: NodeId,
+        pair: u32,
+    ) -> ([f32; 2], [Option<[f32; 2]>; 2]) {
+        match self {
+            NodeWeights::Tree(x, n) => tree.pair_child_importances_ahead(pair, *x, *n),
+            NodeWeights::Bo(_) => (self.children(tree, id, pair), [None; 2]),
         }
     }
 }
@@ -184,8 +215,11 @@ impl NodeWeights {
 /// The resampled hierarchical tree as a strategy.
 pub struct Rht {
     config: RhtConfig,
-    /// The tree over the scene's lights (None without lights).
-    pub tree: Option<LightTree>,
+    /// The tree over the scene's lights and the gathering's records of its nodes (None
+    /// without lights).
+    pub tree: Option<(LightTree, RhtNodes)>,
+    /// [`zero_split_bound`] of τ.
+    zero_below: f64,
     /// The cap integrals of the BO weight (`rht-bo` only).
     bo: Option<Sptd>,
 }
@@ -198,11 +232,14 @@ impl Rht {
         let tree = if bounds.is_empty() {
             None
         } else {
-            Some(LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?)
+            let tree = LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?;
+            let nodes = RhtNodes::new(&tree);
+            Some((tree, nodes))
         };
         Ok(Rht {
             config,
             tree,
+            zero_below: zero_split_bound(config.opts.tau),
             bo: config.bo.then(Sptd::default),
         })
     }
@@ -221,18 +258,20 @@ impl Rht {
         &'a self,
         sp: &ShadingPoint,
         weights: &'a NodeWeights,
-    ) -> Option<Traversal<'a, impl Fn(NodeId) -> [f32; 2] + 'a>> {
-        let tree = self.tree.as_ref()?;
+    ) -> Option<Traversal<'a>> {
+        let (tree, nodes) = self.tree.as_ref()?;
         Some(Traversal {
             tree,
-            child_weights: move |id| weights.children(tree, id),
+            nodes,
+            weights,
             tau: self.config.opts.tau,
+            zero_below: self.zero_below,
             x: sp.point(),
         })
     }
 
-    /// The candidates of one traversal at `sp`: (light, gathering probability), for tests.
-    pub fn gather(&self, sp: &ShadingPoint, rng: &mut SampleStream) -> Vec<(u32, f32)> {
+    /// The candidates of one traversal at `sp`, for tests.
+    pub fn gather(&self, sp: &ShadingPoint, rng: &mut SampleStream) -> Vec<Gathered> {
         let weights = self.weights(sp);
         let mut out = Vec::new();
         if let Some(t) = self.traversal(sp, &weights) {
@@ -264,16 +303,16 @@ fn weigh_candidates(scene: &Scene, sp: &ShadingPoint, rng: &mut SampleStream, s:
         weights,
         ..
     } = s;
-    for &(light, pi) in gathered.iter() {
+    for g in gathered.iter() {
         let u = rng.next_2d();
-        let Some(sample) = scene.sample_light(light, sp.point(), sp.normal(), u) else {
+        let Some(sample) = scene.sample_light(g.light, sp.point(), sp.normal(), u) else {
             continue;
         };
         let target = luminance(sp.bsdf.eval_cos(sp.wo, sample.wi) * sample.radiance);
-        let w = target / (pi * sample.pdf);
+        let w = target / (g.pi * sample.pdf);
         if target > 0.0 && target.is_finite() && w > 0.0 && w.is_finite() {
             candidates.push(Candidate {
-                light,
+                descent: g.descent,
                 sample,
                 target,
             });
@@ -324,9 +363,8 @@ impl DirectLighting for Rht {
         );
         ctx.counters.technique_samples[TECHNIQUE_CANDIDATES] += s.gathered.len() as u64;
         weigh_candidates(scene, sp, rng, s);
-        // P_D(ℓ)·p_pt(y): the light side's density in the MIS weights (module docs).
-        let light_density =
-            |light: u32, pt_pdf: f32| traversal.descent_pmf(light as usize) * pt_pdf;
+        // P_D(ℓ)·p_pt(y): the light side's density in the MIS weights (module docs); a
+        // candidate carries its P_D from the gathering, a BSDF sample's light replays it.
         let picks = self.config.opts.picks;
         let mut l = Vec3::ZERO;
         for _ in 0..picks {
@@ -340,7 +378,7 @@ impl DirectLighting for Rht {
                 continue;
             }
             let w = if with_bsdf && !c.sample.is_delta {
-                power2(light_density(c.light, c.sample.pdf), p_bsdf)
+                power2(c.descent * c.sample.pdf, p_bsdf)
             } else {
                 1.0
             };
@@ -352,7 +390,7 @@ impl DirectLighting for Rht {
                 && b.found_light()
             {
                 let pt = scene.light_pdf(b.light, sp.point(), sp.normal(), b.point, b.normal);
-                let p_light = light_density(b.light, pt);
+                let p_light = traversal.descent_pmf(b.light as usize) * pt;
                 l += b.f_cos * b.radiance * (power2(b.pdf, p_light) / b.pdf);
             }
         }

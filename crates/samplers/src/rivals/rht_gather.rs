@@ -26,7 +26,26 @@
 //! expected weight s + (1 − s)·p_a / q_a < 1 per level where 0 < s < 1, so the image is dark.
 //! We could not read the talk's own pseudo-code: this is our reading of the reported defect,
 //! kept to show the bias in a test (`tests/rht.rs`), not to be used.
-use light_tree::{LightTree, NodeId, SplitCriterion};
+//!
+//! **Cost.** Most visited nodes lie on a single path down, so the per-node work is what
+//! counts (none of it changes a value, so the images are those of the plain form bit for
+//! bit):
+//!
+//! * the tree's importance is evaluated every other level: one eight-lane pass gives a node's
+//!   children's weights and those of both children's children, whichever child comes next
+//!   ([`LightTree::pair_child_importances_ahead`]; a pair alone fills two of four lanes);
+//! * the node's topology, the handle of its children's compact pair and the inputs of the
+//!   split measure come from one record ([`super::rht_nodes`]), the records of both children
+//!   and the pairs of the next level requested ahead; the split probability skips its square
+//!   roots where it is surely 0 or 1;
+//! * the child a step goes on into is kept out of the stack (only a split's right child is
+//!   pushed);
+//! * each candidate carries its single-descent pmf (Π p on its path), which the MIS weight of
+//!   the picked candidate needs, multiplied up with the same operations as
+//!   [`Traversal::descent_pmf`], so it equals that replay bit for bit without a second walk.
+use super::rht::NodeWeights;
+use super::rht_nodes::{Kind, RhtNodes};
+use light_tree::{LightTree, NodeId};
 use render_core::rng::SampleStream;
 
 pub use super::rht_options::RhtTraversal;
@@ -37,17 +56,42 @@ fn sanitize(w: f32) -> f32 {
     if w > 0.0 { w.min(f32::MAX / 4.0) } else { 0.0 }
 }
 
-/// What the traversal at one shading point reads: the tree, the child weights of an interior
-/// node, the split threshold τ and the receiver for the split measure.
-pub struct Traversal<'a, W: Fn(NodeId) -> [f32; 2]> {
+/// What the traversal at one shading point reads: the tree and its records, the child weights
+/// of an interior node, the split threshold τ and the receiver for the split measure.
+pub struct Traversal<'a> {
     /// The tree over the scene's lights.
     pub tree: &'a LightTree,
-    /// Weights of the two children of an interior node (e.g. their E&K importances).
-    pub child_weights: W,
+    /// The gathering's records of the tree's nodes.
+    pub nodes: &'a RhtNodes,
+    /// The weights of an interior node's two children (e.g. their E&K importances).
+    pub weights: &'a NodeWeights,
     /// τ of the split probability (0: never split, a single descent).
     pub tau: f32,
+    /// [`super::rht_nodes::zero_split_bound`] of τ.
+    pub zero_below: f64,
     /// The receiver position.
     pub x: render_core::Vec3,
+}
+
+/// A gathered candidate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Gathered {
+    /// The light.
+    pub light: u32,
+    /// π(light): the probability that the gathering reaches it.
+    pub pi: f32,
+    /// Its pmf under a single descent by the same weights ([`Traversal::descent_pmf`]).
+    pub descent: f32,
+}
+
+/// A node on the traversal's stack, with the probabilities of the path that reached it and,
+/// when its parent's evaluation already gave them, its children's weights.
+#[derive(Clone, Copy, Debug)]
+pub struct Visit {
+    id: NodeId,
+    pi: f32,
+    descent: f32,
+    weights: Option<[f32; 2]>,
 }
 
 /// One interior node's step: the children's sanitised weights and the split probability.
@@ -56,69 +100,110 @@ struct Step {
     split: f32,
 }
 
-impl<W: Fn(NodeId) -> [f32; 2]> Traversal<'_, W> {
-    /// s(N) where both children have weight, else 0 (module docs).
-    fn step(&self, id: NodeId) -> Step {
-        let raw = (self.child_weights)(id);
+impl Traversal<'_> {
+    /// s(N) where both children have weight, else 0 (module docs); `raw` are the children's
+    /// weights.
+    #[inline]
+    fn step(&self, id: NodeId, raw: [f32; 2]) -> Step {
         let w = [sanitize(raw[0]), sanitize(raw[1])];
         let split = if w[0] > 0.0 && w[1] > 0.0 && self.tau > 0.0 {
-            // ρ = (1 + σ)^(−1/4), as `split_metric`, by two square roots instead of powf.
-            let sigma = self.tree.split_sigma(id, self.x, SplitCriterion::UnitFree);
-            let rho = (1.0 / (1.0 + sigma).sqrt().sqrt()) as f32;
-            (1.0 - rho / self.tau).clamp(0.0, 1.0)
+            self.nodes.split(id, self.x, self.tau, self.zero_below)
         } else {
             0.0
         };
         Step { w, split }
     }
 
-    /// Gathers the candidates into `out` as (light, gathering probability), in depth-first
-    /// order (left child first); `stack` is scratch.
+    /// Gathers the candidates into `out`, in depth-first order (left child first); `stack` is
+    /// scratch.
     pub fn gather(
         &self,
         form: RhtTraversal,
         rng: &mut SampleStream,
-        stack: &mut Vec<(NodeId, f32)>,
-        out: &mut Vec<(u32, f32)>,
+        stack: &mut Vec<Visit>,
+        out: &mut Vec<Gathered>,
     ) {
         stack.clear();
-        stack.push((self.tree.root(), 1.0));
-        while let Some((id, prob)) = stack.pop() {
-            let node = self.tree.node(id);
-            if let Some(light) = node.light() {
-                out.push((light as u32, prob));
-                continue;
-            }
-            let Some((l, r)) = node.children(id) else {
-                continue;
+        // The node to visit next: the child a step went on into, kept out of the stack (a
+        // store and a reload per level), or else the right child a split left there.
+        let mut next = Some(Visit {
+            id: self.tree.root(),
+            pi: 1.0,
+            descent: 1.0,
+            weights: None,
+        });
+        while let Some(visit) = next.take().or_else(|| stack.pop()) {
+            let (l, r, pair) = match self.nodes.kind(visit.id) {
+                Kind::Leaf(light) => {
+                    let (pi, descent) = (visit.pi, visit.descent);
+                    out.push(Gathered { light, pi, descent });
+                    continue;
+                }
+                Kind::Interior { left, right, pair } => (left, right, pair),
             };
-            let Step { w, split } = self.step(id);
-            let sum = w[0] + w[1];
-            if sum == 0.0 {
-                continue;
-            }
-            if w[0] == 0.0 || w[1] == 0.0 {
-                stack.push((if w[0] > 0.0 { l } else { r }, prob));
-                continue;
-            }
-            let p_left = w[0] / sum;
-            let q = [
-                split + (1.0 - split) * p_left,
-                split + (1.0 - split) * (w[1] / sum),
-            ];
-            let u = rng.next_f32();
-            if u < split {
-                let (ql, qr) = match form {
-                    RhtTraversal::Corrected => (q[0], q[1]),
-                    RhtTraversal::Biased => (1.0, 1.0),
-                };
-                stack.push((r, prob * qr));
-                stack.push((l, prob * ql));
-            } else {
-                let v = (u - split) / (1.0 - split);
-                let (child, qc) = if v < p_left { (l, q[0]) } else { (r, q[1]) };
-                stack.push((child, prob * qc));
-            }
+            self.nodes.prefetch(l, r);
+            self.tree.prefetch_next_pairs(pair);
+            // The weights of this node's children, and where they come from an evaluation
+            // here, those of its grandchildren too (for the next level, whichever it is).
+            let (raw, below) = match visit.weights {
+                Some(w) => (w, [None; 2]),
+                None => self.weights.children_ahead(self.tree, visit.id, pair),
+            };
+            next = self.step_down(form, rng, &visit, [l, r], raw, below, stack);
+        }
+    }
+
+    /// The decision at an interior node (`visit`, children `lr` with weights `raw`): the child
+    /// it goes on into (the left one where it splits, the right one then pushed on `stack`),
+    /// with its path probabilities and any known weights `below`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline]
+    fn step_down(
+        &self,
+        form: RhtTraversal,
+        rng: &mut SampleStream,
+        visit: &Visit,
+        lr: [NodeId; 2],
+        raw: [f32; 2],
+        below: [Option<[f32; 2]>; 2],
+        stack: &mut Vec<Visit>,
+    ) -> Option<Visit> {
+        let Step { w, split } = self.step(visit.id, raw);
+        let sum = w[0] + w[1];
+        if sum == 0.0 {
+            return None;
+        }
+        let (pi, descent) = (visit.pi, visit.descent);
+        if w[0] == 0.0 || w[1] == 0.0 {
+            let side = (w[0] == 0.0) as usize;
+            let (id, weights) = (lr[side], below[side]);
+            return Some(Visit {
+                id,
+                pi,
+                descent,
+                weights,
+            });
+        }
+        let p = [w[0] / sum, w[1] / sum];
+        let q = [split + (1.0 - split) * p[0], split + (1.0 - split) * p[1]];
+        let child = |side: usize, q: f32| Visit {
+            id: lr[side],
+            pi: pi * q,
+            descent: descent * p[side],
+            weights: below[side],
+        };
+        let u = rng.next_f32();
+        if u < split {
+            let (ql, qr) = match form {
+                RhtTraversal::Corrected => (q[0], q[1]),
+                RhtTraversal::Biased => (1.0, 1.0),
+            };
+            stack.push(child(1, qr));
+            Some(child(0, ql))
+        } else {
+            let v = (u - split) / (1.0 - split);
+            let side = (v >= p[0]) as usize;
+            Some(child(side, q[side]))
         }
     }
 
@@ -130,10 +215,10 @@ impl<W: Fn(NodeId) -> [f32; 2]> Traversal<'_, W> {
         let mut bits = tree.bit_trail(light);
         let (mut id, mut pmf) = (tree.root(), 1.0f32);
         while id != leaf {
-            let Some((l, r)) = tree.node(id).children(id) else {
+            let Kind::Interior { left, right, pair } = self.nodes.kind(id) else {
                 return 0.0;
             };
-            let raw = (self.child_weights)(id);
+            let raw = self.weights.children(tree, id, pair);
             let w = [sanitize(raw[0]), sanitize(raw[1])];
             let side = (bits & 1) as usize;
             if w[side] == 0.0 {
@@ -142,7 +227,7 @@ impl<W: Fn(NodeId) -> [f32; 2]> Traversal<'_, W> {
             if w[1 - side] > 0.0 {
                 pmf *= w[side] / (w[0] + w[1]);
             }
-            id = if side == 0 { l } else { r };
+            id = if side == 0 { left } else { right };
             bits >>= 1;
         }
         pmf
@@ -156,10 +241,10 @@ impl<W: Fn(NodeId) -> [f32; 2]> Traversal<'_, W> {
         let mut bits = tree.bit_trail(light);
         let (mut id, mut pi, mut descent) = (tree.root(), 1.0f32, 1.0f32);
         while id != leaf {
-            let Some((l, r)) = tree.node(id).children(id) else {
+            let Kind::Interior { left, right, pair } = self.nodes.kind(id) else {
                 return (0.0, 0.0);
             };
-            let Step { w, split } = self.step(id);
+            let Step { w, split } = self.step(id, self.weights.children(tree, id, pair));
             let side = (bits & 1) as usize;
             let sum = w[0] + w[1];
             if w[side] == 0.0 {
@@ -170,7 +255,7 @@ impl<W: Fn(NodeId) -> [f32; 2]> Traversal<'_, W> {
                 pi *= split + (1.0 - split) * p;
                 descent *= p;
             }
-            id = if side == 0 { l } else { r };
+            id = if side == 0 { left } else { right };
             bits >>= 1;
         }
         (pi, descent)

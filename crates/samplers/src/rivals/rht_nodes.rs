@@ -1,0 +1,145 @@
+//! What the RHT gathering ([`super::rht_gather`]) reads of a node, in one 32-byte record per
+//! node: the tree's topology, the handle of the children's compact pair (their importances)
+//! and the inputs of the split measure.
+//!
+//! The gathering visits tens of nodes per shading point, most of them once on a single path
+//! down, and at each it read the node (is it a leaf, where are its children), the node's slot
+//! and its parent's pair (where its children's pair is), the children's pair, and the node's
+//! extra data (the power spread of the split measure): four or five dependent cache lines
+//! from four arrays. Here one record holds all but the pair, the records of both children are
+//! requested while the current node is worked on, and the split probability is computed
+//! inline with the same operations as [`LightTree::split_sigma`], so every value, and so the
+//! image, stays the same bit for bit.
+use light_tree::{LightTree, NodeId};
+use render_core::Vec3;
+
+/// `pair` of a leaf.
+const LEAF: u32 = u32::MAX;
+
+/// One node's record.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+struct Record {
+    /// Centre of the bounding sphere, as [`light_tree::Node::center`].
+    centre: Vec3,
+    /// radius², rounded to f32 as `split_sigma` rounds it.
+    r2: f32,
+    /// The power spread V\[Φ\]/E\[Φ\]² of the node's lights.
+    power_cv2: f32,
+    /// Handle of the children's compact pair ([`LightTree::children_pair_of`]); [`LEAF`].
+    pair: u32,
+    /// Interior: the right child's id (the left one is id + 1). Leaf: the light.
+    code: u32,
+}
+
+/// What a node is to the gathering.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A leaf holding this light.
+    Leaf(u32),
+    /// An interior node: its children (left, right) and their compact pair.
+    Interior {
+        /// Left child.
+        left: NodeId,
+        /// Right child.
+        right: NodeId,
+        /// Handle of the children's pair.
+        pair: u32,
+    },
+}
+
+/// The records of every node of a tree, indexed by [`NodeId`].
+#[derive(Clone, Debug, Default)]
+pub struct RhtNodes {
+    records: Vec<Record>,
+}
+
+impl RhtNodes {
+    /// The records of `tree`'s nodes.
+    pub fn new(tree: &LightTree) -> RhtNodes {
+        let records = (0..tree.nodes().len() as NodeId)
+            .map(|id| {
+                let node = tree.node(id);
+                let (pair, code) = match (node.light(), node.children(id)) {
+                    (Some(light), _) => (LEAF, light as u32),
+                    (None, Some((_, right))) => (tree.children_pair_of(id).unwrap_or(LEAF), right),
+                    (None, None) => (LEAF, u32::MAX),
+                };
+                Record {
+                    centre: node.center(),
+                    r2: node.radius() * node.radius(),
+                    power_cv2: tree.node_extra(id).power_cv2,
+                    pair,
+                    code,
+                }
+            })
+            .collect();
+        RhtNodes { records }
+    }
+
+    /// What node `id` is.
+    #[inline]
+    pub fn kind(&self, id: NodeId) -> Kind {
+        let r = &self.records[id as usize];
+        if r.pair == LEAF {
+            Kind::Leaf(r.code)
+        } else {
+            Kind::Interior {
+                left: id + 1,
+                right: r.code,
+                pair: r.pair,
+            }
+        }
+    }
+
+    /// Starts loading the records of `left` and `right` (a hint).
+    #[inline(always)]
+    pub fn prefetch(&self, left: NodeId, right: NodeId) {
+        #[cfg(target_arch = "x86_64")]
+        for id in [left, right] {
+            if let Some(r) = self.records.get(id as usize) {
+                use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+                // SAFETY: a prefetch never faults, and `r` is a live reference.
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(r as *const Record as *const i8) };
+            }
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = (left, right);
+    }
+
+    /// The split probability clamp(1 − ρ/τ, 0, 1) of interior node `id` seen from `x`, with
+    /// ρ = (1 + σ)^(−1/4) and σ [`LightTree::split_sigma`]'s unit-free measure, in the same
+    /// operations (so the same bits); `zero_below` is [`zero_split_bound`]`(τ)`.
+    #[inline]
+    pub fn split(&self, id: NodeId, x: Vec3, tau: f32, zero_below: f64) -> f32 {
+        let r = &self.records[id as usize];
+        let d2 = (r.centre - x).length_squared() as f64;
+        let r2 = r.r2 as f64;
+        if d2 <= r2 {
+            // σ = ∞: ρ = 0, split for sure.
+            return 1.0;
+        }
+        let cg = 4.0 * r2 / (3.0 * (d2 - r2));
+        let cv2 = (1.0 + r.power_cv2 as f64) * (1.0 + cg) - 1.0;
+        if cv2 <= zero_below {
+            // ρ/τ ≥ 1.0001: the clamp gives 0 without the square roots.
+            return 0.0;
+        }
+        let sigma = cv2.max(0.0).sqrt();
+        let rho = (1.0 / (1.0 + sigma).sqrt().sqrt()) as f32;
+        (1.0 - rho / tau).clamp(0.0, 1.0)
+    }
+}
+
+/// The squared σ below which ρ/τ ≥ 1.0001, so that clamp(1 − ρ/τ, 0, 1) is 0 whatever the
+/// rounding of ρ (f64 to f32, relative error 6e-8) and of the division (6e-8); −∞ (no shortcut)
+/// where no σ ≥ 0 gives that.
+pub fn zero_split_bound(tau: f32) -> f64 {
+    let rho = tau as f64 * 1.0001;
+    let sigma = rho.powi(-4) - 1.0;
+    if sigma > 0.0 {
+        sigma * sigma
+    } else {
+        f64::NEG_INFINITY
+    }
+}
