@@ -143,3 +143,79 @@ pub fn zero_split_bound(tau: f32) -> f64 {
         f64::NEG_INFINITY
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use light_tree::{LightBounds, SplitCriterion};
+    use rand::{RngExt, SeedableRng};
+
+    /// The split probability as the tree's own measure gives it, with no shortcut.
+    fn reference(tree: &LightTree, id: NodeId, x: Vec3, tau: f32) -> f32 {
+        let sigma = tree.split_sigma(id, x, SplitCriterion::UnitFree);
+        let rho = (1.0 / (1.0 + sigma).sqrt().sqrt()) as f32;
+        (1.0 - rho / tau).clamp(0.0, 1.0)
+    }
+
+    /// The records' split equals the reference bit for bit at every interior node, for
+    /// receivers near and far and τ across its range, and each of the three outcomes (0, 1,
+    /// in between) occurs; the records' topology is the tree's.
+    #[test]
+    fn split_and_topology_match_the_tree() {
+        let mut rng = rand_pcg::Pcg32::seed_from_u64(11);
+        let lights: Vec<LightBounds> = (0..500)
+            .map(|_| {
+                let c = Vec3::new(
+                    rng.random_range(-10.0..10.0),
+                    rng.random_range(-10.0..10.0),
+                    rng.random_range(0.0..5.0),
+                );
+                let e = Vec3::splat(rng.random_range(0.01..0.5));
+                LightBounds {
+                    aabb_min: c - e,
+                    aabb_max: c + e,
+                    axis: Vec3::Z,
+                    theta_o: 0.5,
+                    theta_e: std::f32::consts::FRAC_PI_2,
+                    power: rng.random_range(0.1..10.0),
+                    two_sided: false,
+                }
+            })
+            .collect();
+        let tree = LightTree::build(&lights).unwrap();
+        let nodes = RhtNodes::new(&tree);
+        let mut seen = [0usize; 3];
+        for tau in [0.05, 0.3, 0.5, 0.85, 0.999_9, 1.0] {
+            let zero_below = zero_split_bound(tau);
+            for _ in 0..30 {
+                let x = Vec3::new(
+                    rng.random_range(-15.0..15.0),
+                    rng.random_range(-15.0..15.0),
+                    rng.random_range(-8.0..8.0),
+                );
+                for id in 0..tree.nodes().len() as NodeId {
+                    let node = tree.node(id);
+                    let Kind::Interior { left, right, pair } = nodes.kind(id) else {
+                        assert_eq!(nodes.kind(id), Kind::Leaf(node.light().unwrap() as u32));
+                        continue;
+                    };
+                    assert_eq!(Some((left, right)), node.children(id));
+                    assert_eq!(Some(pair), tree.children_pair_of(id));
+                    let got = nodes.split(id, x, tau, zero_below);
+                    assert_eq!(got.to_bits(), reference(&tree, id, x, tau).to_bits());
+                    seen[if got == 0.0 {
+                        0
+                    } else if got == 1.0 {
+                        1
+                    } else {
+                        2
+                    }] += 1;
+                }
+            }
+        }
+        assert!(
+            seen.iter().all(|&k| k > 100),
+            "outcomes 0, 1, between: {seen:?}"
+        );
+    }
+}
