@@ -42,15 +42,13 @@ impl Passes {
             if let Some(sp) = &sp {
                 camera.distant = distant_lighting(job.scene, sp, c);
             }
-            let extra = job.extra_emission(i, sample_index, rays, c);
-            let sample = PixelSample {
-                on_film,
-                weight,
+            let sample = job.pixel_sample(
+                (i, sample_index),
+                (on_film, weight),
                 rays,
-                camera,
-                extra,
-                aux: [0.0; MAX_AUX],
-            };
+                (camera, [0.0; MAX_AUX]),
+                c,
+            );
             (sample, sp, rng)
         });
         counters.merge(&c);

@@ -77,16 +77,35 @@ impl PassJob<'_> {
                 &mut ctx,
             );
             let aux = ctx.aux;
-            let extra = self.extra_emission(index, sample_index, rays, c);
-            let sample = PixelSample {
-                on_film,
-                weight,
+            let sample = self.pixel_sample(
+                (index, sample_index),
+                (on_film, weight),
                 rays,
-                camera,
-                extra,
-                aux,
-            };
+                (camera, aux),
+                c,
+            );
             self.accumulate(px, splats.get_mut(i), sample, pass_weight);
+        }
+    }
+
+    /// Sample `sample_index` of pixel `index`, shaded, with its extra emission rays traced
+    /// (`rays` camera rays in all).
+    pub(super) fn pixel_sample(
+        &self,
+        (index, sample_index): (usize, u64),
+        (on_film, weight): (Vec2, f32),
+        rays: u32,
+        (camera, aux): (CameraSample, [f32; MAX_AUX]),
+        c: &mut Counters,
+    ) -> PixelSample {
+        let extra = self.extra_emission(index, sample_index, rays, c);
+        PixelSample {
+            on_film,
+            weight,
+            rays,
+            camera,
+            extra,
+            aux,
         }
     }
 

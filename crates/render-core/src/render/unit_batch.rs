@@ -5,7 +5,6 @@
 use super::accum::PixelAccum;
 use super::pass_job::{PassJob, UNIT_PIXELS};
 use super::shading::{camera_ray, distant_lighting, seen_by_camera};
-use super::unit::PixelSample;
 use crate::batch::{BatchLighting, ShadingBatch};
 use crate::estimator::MAX_AUX;
 use crate::splat::PassSample;
@@ -83,15 +82,13 @@ impl PassJob<'_> {
                 camera.direct = l;
                 camera.distant = distant_lighting(self.scene, sp, c);
             }
-            let extra = self.extra_emission(index, sample_index, rays, c);
-            let sample = PixelSample {
-                on_film,
-                weight,
+            let sample = self.pixel_sample(
+                (index, sample_index),
+                (on_film, weight),
                 rays,
-                camera,
-                extra,
-                aux: [0.0; MAX_AUX],
-            };
+                (camera, [0.0; MAX_AUX]),
+                c,
+            );
             self.accumulate(px, splats.get_mut(i), sample, pass_weight);
         }
     }
