@@ -9,7 +9,9 @@
 //! added in the same order (the light picks in pick order, the BSDF sample's term last).
 //!
 //! [`DirectLighting::estimate`]: render_core::estimator::DirectLighting::estimate
-use super::light_strategy::{LightStrategy, Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT};
+use super::light_strategy::{
+    LightStrategy, Picks, TECHNIQUE_BSDF, TECHNIQUE_LIGHT, sample_pick_unshadowed,
+};
 use crate::bsdf_sampling::{BsdfDirection, bsdf_direction};
 use crate::mis::power2;
 use crate::scratch::Pooled;
@@ -169,22 +171,14 @@ impl<S: LightSelection> LightStrategy<S> {
         rays: &mut Vec<StreamRay>,
         counters: &mut Counters,
     ) -> Option<Pending> {
-        let s = scene.sample_light(p.light, sp.point(), sp.normal(), p.u)?;
-        let p_light = p.pmf * s.pdf;
-        if !(p_light > 0.0) {
-            return None;
-        }
-        let (f, p_bsdf) = sp.unshadowed_with_pdf(&s);
-        if f == Vec3::ZERO {
-            return None;
-        }
-        counters.shadow_rays += 1;
+        let (s, p_light, f, p_bsdf, ray) =
+            sample_pick_unshadowed(scene, sp, (p.light, p.pmf), p.u, counters)?;
         let w = if self.with_bsdf && !s.is_delta {
             power2(p_light, p_bsdf)
         } else {
             1.0
         };
-        rays.push(sp.shadow_ray(scene, &s));
+        rays.push(ray);
         Some(Pending {
             term: f * (w / p_light),
             ray: rays.len() - 1,

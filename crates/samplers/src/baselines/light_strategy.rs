@@ -5,6 +5,7 @@ use crate::mis::power2;
 use crate::scratch::Pooled;
 use crate::selection::{LightSelection, PowerSelection, UniformSelection};
 use crate::strategy::Strategy;
+use render_core::accel::StreamRay;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
 use render_core::light::LightSample;
 use render_core::rng::SampleStream;
@@ -52,6 +53,30 @@ pub(crate) fn sample_pick(
     counters: &mut Counters,
 ) -> Option<(LightSample, f32, Vec3, f32)> {
     sample_pick_at(scene, sp, light, pmf, rng.next_2d(), counters)
+}
+
+/// [`sample_pick_at`] before visibility: the sample, pmf × point pdf, the unshadowed f·L, the
+/// BSDF's density of its direction and the shadow ray that decides it (counted), or `None`
+/// where the sample adds nothing whatever the ray finds.
+pub(crate) fn sample_pick_unshadowed(
+    scene: &Scene,
+    sp: &ShadingPoint,
+    (light, pmf): (u32, f32),
+    u: Vec2,
+    counters: &mut Counters,
+) -> Option<(LightSample, f32, Vec3, f32, StreamRay)> {
+    let s = scene.sample_light(light, sp.point(), sp.normal(), u)?;
+    let p = pmf * s.pdf;
+    if !(p > 0.0) {
+        return None;
+    }
+    let (f, p_bsdf) = sp.unshadowed_with_pdf(&s);
+    if f == Vec3::ZERO {
+        return None;
+    }
+    counters.shadow_rays += 1;
+    let ray = sp.shadow_ray(scene, &s);
+    Some((s, p, f, p_bsdf, ray))
 }
 
 /// [`sample_pick`] with the point's two numbers given.

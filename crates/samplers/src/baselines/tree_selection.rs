@@ -349,6 +349,10 @@ impl crate::brdf_oriented::ls_technique::LsTechnique for TreeSelection {
         }
     }
 
+    fn defers_visibility(&self) -> bool {
+        true
+    }
+
     fn sample_ls(
         &self,
         _: &TreeState,

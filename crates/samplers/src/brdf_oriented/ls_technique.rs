@@ -31,6 +31,12 @@ pub trait LsTechnique: LightSelection + Send + Sync {
         rng: &mut SampleStream,
         ctx: &mut SampleContext,
     ) -> Option<(LightSample, f32, Vec3, f32)>;
+    /// Whether its `sample_ls` is [`crate::light_strategy::sample_pick`] (a point on the light
+    /// from two numbers, shaded, nothing learnt from the value), so that the method may draw
+    /// the same sample before visibility and trace its shadow ray later with the others.
+    fn defers_visibility(&self) -> bool {
+        false
+    }
     /// Forgets what an earlier render taught it.
     fn begin_render(&self) {}
     /// Learns from a finished pass's pixel memories, in pixel order.

@@ -26,6 +26,7 @@ use render_core::estimator::{DirectLighting, PIXEL_MEMORY, SampleContext, Shadin
 use render_core::pilot::Pilot;
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
+use std::cell::RefCell;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -317,6 +318,7 @@ where
         } = &mut *scratch;
         point.ls_samples(taken, picks, rng, ctx);
         let counts = self.brdf_aware_samples(&point, taken, rng, ctx);
+        point.resolve_shadows(taken);
         record_counts(&point, &counts, ctx);
         let learns = self.learns_n_max();
         // Stratified BO terms are kept in stratum order for their variance (`record_efficiency`).
@@ -393,6 +395,8 @@ where
             ls_state,
             bo,
             fresh: !self.config.reproduce,
+            // The authors' in-sample allocation looks at samples' values as it draws them.
+            shadows: (!self.config.reproduce).then(|| RefCell::new(Pooled::take())),
         }
     }
 

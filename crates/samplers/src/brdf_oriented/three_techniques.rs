@@ -5,12 +5,16 @@ use super::importance::LobeDensity;
 use super::ls_technique::LsTechnique;
 use super::technique::BoState;
 use crate::bsdf_sampling::{sample_bsdf, sample_bsdf_at};
+use crate::light_strategy::sample_pick_unshadowed;
+use crate::scratch::Pooled;
 use brdf_integrals::LobeIntegral;
 use light_tree::LightTree;
+use render_core::accel::StreamRay;
 use render_core::estimator::{SampleContext, ShadingPoint};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::{Vec2, Vec3};
+use std::cell::RefCell;
 
 /// Index of tree-splitting light sampling in [`Taken::p`] and the technique counters.
 pub const TECHNIQUE_LS: usize = 0;
@@ -31,7 +35,24 @@ pub struct Taken {
     pub f: Vec3,
     /// The three techniques' densities at its light point (solid angle × selection).
     pub p: [f32; 3],
+    /// Its shadow ray in the point's queue ([`PointTechniques::shadows`]) when its visibility
+    /// is still to be decided, else [`NO_RAY`].
+    pub ray: u32,
 }
+
+/// [`Taken::ray`] of a sample whose visibility is already in `f`.
+pub const NO_RAY: u32 = u32::MAX;
+
+/// Per-thread buffers of one shading point's queued shadow rays and their answers.
+#[derive(Default)]
+pub struct ShadowQueue {
+    rays: Vec<StreamRay>,
+    blocked: Vec<bool>,
+}
+crate::scratch_pool!(ShadowQueue, |q| {
+    q.rays.clear();
+    q.blocked.clear();
+});
 
 /// One shading point with both cuts made: the LS state (E&K cut or one descent) and, at a
 /// glossy point, the BO state (BO cut and its record).
@@ -50,6 +71,10 @@ pub struct PointTechniques<'a, L, S: LsTechnique> {
     pub bo: Option<BoState<'a, L>>,
     /// BO's descent takes a fresh random number per tree level (off: the authors' rescaled one).
     pub fresh: bool,
+    /// Where the LS and BO samples' shadow rays wait to be traced together as one stream
+    /// ([`PointTechniques::resolve_shadows`]); `None`: each is traced when its sample is drawn.
+    /// Only for allocations that never look at a sample's value before all are drawn.
+    pub shadows: Option<RefCell<Pooled<ShadowQueue>>>,
 }
 
 impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
@@ -102,15 +127,26 @@ impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
     ) {
         let (scene, sp) = (self.scene, self.sp);
         self.ls.pick(&self.ls_state, sp, rng, picks);
+        let defer = self.shadows.is_some() && self.ls.defers_visibility();
         for &(light, pmf) in picks.iter() {
             ctx.counters.technique_samples[TECHNIQUE_LS] += 1;
-            let sampled = self
-                .ls
-                .sample_ls(&self.ls_state, scene, sp, light, pmf, rng, ctx)
-                .map(|(s, p, f, p_bsdf)| (s, p, f, Some(p_bsdf)));
+            let (sampled, ray) = if defer {
+                let s =
+                    sample_pick_unshadowed(scene, sp, (light, pmf), rng.next_2d(), ctx.counters);
+                match s {
+                    Some((s, p, f, p_bsdf, ray)) => (Some((s, p, f, p_bsdf)), self.queue(ray)),
+                    None => (None, NO_RAY),
+                }
+            } else {
+                let s = self
+                    .ls
+                    .sample_ls(&self.ls_state, scene, sp, light, pmf, rng, ctx);
+                (s, NO_RAY)
+            };
             let Some((s, p_ls, f, p_bsdf)) = sampled else {
                 continue;
             };
+            let p_bsdf = Some(p_bsdf);
             let mut p = self.densities(
                 light as usize,
                 s.point,
@@ -134,6 +170,7 @@ impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
                 index: 0,
                 f,
                 p,
+                ray,
             });
         }
     }
@@ -165,7 +202,20 @@ impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
         if !(p_bo > 0.0) {
             return;
         }
-        let (f, p_bsdf) = sp.shade_with_pdf(scene, &s, ctx.counters);
+        let (f, p_bsdf, ray) = match &self.shadows {
+            None => {
+                let (f, p_bsdf) = sp.shade_with_pdf(scene, &s, ctx.counters);
+                (f, p_bsdf, NO_RAY)
+            }
+            Some(_) => {
+                let (f, p_bsdf) = sp.unshadowed_with_pdf(&s);
+                if f == Vec3::ZERO {
+                    return;
+                }
+                ctx.counters.shadow_rays += 1;
+                (f, p_bsdf, self.queue(sp.shadow_ray(scene, &s)))
+            }
+        };
         if f == Vec3::ZERO {
             return;
         }
@@ -189,6 +239,7 @@ impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
             index,
             f,
             p,
+            ray,
         });
     }
 
@@ -228,8 +279,33 @@ impl<L: LobeIntegral + LobeDensity, S: LsTechnique> PointTechniques<'_, L, S> {
             index: 0,
             f: b.f_cos * b.radiance,
             p,
+            ray: NO_RAY,
         });
         true
+    }
+
+    /// Queues a shadow ray; its index in the queue.
+    fn queue(&self, ray: StreamRay) -> u32 {
+        let mut q = self
+            .shadows
+            .as_ref()
+            .expect("a queue to defer to")
+            .borrow_mut();
+        q.rays.push(ray);
+        (q.rays.len() - 1) as u32
+    }
+
+    /// Traces the queued shadow rays as one stream and drops the samples whose ray is
+    /// blocked: `taken` is then what tracing each ray at once leaves, in the same order.
+    pub fn resolve_shadows(&self, taken: &mut Vec<Taken>) {
+        let Some(q) = &self.shadows else { return };
+        let mut q = q.borrow_mut();
+        if q.rays.is_empty() {
+            return;
+        }
+        let ShadowQueue { rays, blocked } = &mut **q;
+        self.scene.occluded_stream(rays, blocked);
+        taken.retain(|t| t.ray == NO_RAY || !blocked[t.ray as usize]);
     }
 
     /// Clusters of the LS cut and of the BO cut (0 without BO).
