@@ -44,7 +44,7 @@ macro_rules! compiled_for {
                 rays: &[StreamRay],
                 hits: &mut [Option<Hit>],
             ) {
-                stream::closest_stream::<$test>(w, need, rays, hits)
+                stream::closest_stream::<$test>(w, need, stream::HOT_NODES, rays, hits)
             }
 
             #[target_feature(enable = $features)]
@@ -54,7 +54,7 @@ macro_rules! compiled_for {
                 rays: &[StreamRay],
                 blocked: &mut [bool],
             ) {
-                stream::occluded_stream::<$test>(w, need, rays, blocked)
+                stream::occluded_stream::<$test>(w, need, stream::HOT_NODES, rays, blocked)
             }
         }
     };

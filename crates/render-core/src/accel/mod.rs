@@ -226,7 +226,7 @@ impl Accel {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as in `intersect`.
             Simd::Avx2 => unsafe { isa::avx2::closest_stream(w, need, rays, hits) },
-            _ => stream::closest_stream::<node::Lanes4>(w, need, rays, hits),
+            _ => stream::closest_stream::<node::Lanes4>(w, need, stream::HOT_NODES, rays, hits),
         }
     }
 
@@ -246,7 +246,7 @@ impl Accel {
             #[cfg(target_arch = "x86_64")]
             // SAFETY: as in `intersect`.
             Simd::Avx2 => unsafe { isa::avx2::occluded_stream(w, need, rays, blocked) },
-            _ => stream::occluded_stream::<node::Lanes4>(w, need, rays, blocked),
+            _ => stream::occluded_stream::<node::Lanes4>(w, need, stream::HOT_NODES, rays, blocked),
         }
     }
 }

@@ -72,13 +72,12 @@ impl Node8 {
     }
 }
 
-/// What the node test needs of a ray: origin, inverse direction, and per axis the row of
-/// the near and the far slab (min first for a non-negative direction).
+/// What the node test needs of a ray: origin, inverse direction, and per axis whether the
+/// direction is negative, which makes the max row the near slab.
 pub struct BoxRay {
     pub(super) o: [f32; 3],
     pub(super) inv: [f32; 3],
-    pub(super) near: [usize; 3],
-    pub(super) far: [usize; 3],
+    neg: [bool; 3],
     pub(super) tmin: f32,
 }
 
@@ -93,17 +92,32 @@ impl BoxRay {
         let mut r = BoxRay {
             o: o.into(),
             inv: [0.0; 3],
-            near: [0; 3],
-            far: [0; 3],
+            neg: [false; 3],
             tmin,
         };
         for axis in 0..3 {
             r.inv[axis] = 1.0 / d[axis];
-            let neg = (r.inv[axis] < 0.0) as usize;
-            r.near[axis] = 2 * axis + neg;
-            r.far[axis] = 2 * axis + 1 - neg;
+            r.neg[axis] = r.inv[axis] < 0.0;
         }
         r
+    }
+
+    /// The ray's origin.
+    #[inline(always)]
+    pub fn origin(&self) -> Vec3 {
+        Vec3::from(self.o)
+    }
+
+    /// The row of the near slab on `axis` (written so the compiler sees it is below 6).
+    #[inline(always)]
+    pub fn near(&self, axis: usize) -> usize {
+        2 * axis + self.neg[axis] as usize
+    }
+
+    /// The row of the far slab on `axis`.
+    #[inline(always)]
+    pub fn far(&self, axis: usize) -> usize {
+        2 * axis + 1 - self.neg[axis] as usize
     }
 }
 
@@ -128,10 +142,10 @@ impl NodeTest for Lanes4 {
             let slab = |i: usize, axis: usize| {
                 row(i).sub(F4::splat(r.o[axis])).mul(F4::splat(r.inv[axis]))
             };
-            let t0 = slab(r.near[0], 0)
-                .max(slab(r.near[1], 1).max(slab(r.near[2], 2).max(F4::splat(r.tmin))));
-            let t1 = slab(r.far[0], 0)
-                .min(slab(r.far[1], 1).min(slab(r.far[2], 2)))
+            let t0 = slab(r.near(0), 0)
+                .max(slab(r.near(1), 1).max(slab(r.near(2), 2).max(F4::splat(r.tmin))));
+            let t1 = slab(r.far(0), 0)
+                .min(slab(r.far(1), 1).min(slab(r.far(2), 2)))
                 .mul(F4::splat(FAR_SCALE))
                 .min(F4::splat(tmax));
             mask |= t0.le(t1) << (4 * half);
@@ -141,7 +155,9 @@ impl NodeTest for Lanes4 {
     }
 }
 
-/// One 8-lane pass; only for callers that checked AVX2 is present.
+/// One 8-lane pass; only for callers that checked AVX2 is present. It picks each axis's
+/// near and far rows by the sign of 1/d, which `BoxRay::new` leaves never −0 nor NaN (the
+/// direction is finite and has no −0.0), so it picks the rows `BoxRay::near` names.
 #[cfg(target_arch = "x86_64")]
 pub struct Avx2;
 
@@ -155,28 +171,28 @@ impl NodeTest for Avx2 {
         // SAFETY: only instantiated inside functions compiled with AVX2 enabled, which run
         // after `is_x86_feature_detected!("avx2")`; each row is eight readable f32s.
         unsafe {
-            let slab = |i: usize, axis: usize| {
-                _mm256_mul_ps(
-                    _mm256_sub_ps(
-                        _mm256_loadu_ps(n.bounds[i].as_ptr()),
-                        _mm256_set1_ps(r.o[axis]),
-                    ),
-                    _mm256_set1_ps(r.inv[axis]),
-                )
-            };
+            // (near, far) slabs of `axis`: both rows' distances, then the sign of 1/d picks
+            // (the max row is near where it is negative), so no row index is computed. A
+            // macro, not a closure: a closure may be left out of line, without AVX2.
+            macro_rules! slabs {
+                ($axis:literal) => {{
+                    let o = _mm256_set1_ps(r.o[$axis]);
+                    let inv = _mm256_set1_ps(r.inv[$axis]);
+                    let lo = _mm256_loadu_ps(n.bounds[2 * $axis].as_ptr());
+                    let hi = _mm256_loadu_ps(n.bounds[2 * $axis + 1].as_ptr());
+                    let lo = _mm256_mul_ps(_mm256_sub_ps(lo, o), inv);
+                    let hi = _mm256_mul_ps(_mm256_sub_ps(hi, o), inv);
+                    (_mm256_blendv_ps(lo, hi, inv), _mm256_blendv_ps(hi, lo, inv))
+                }};
+            }
+            let ((nx, fx), (ny, fy), (nz, fz)) = (slabs!(0), slabs!(1), slabs!(2));
             let t0 = _mm256_max_ps(
-                slab(r.near[0], 0),
-                _mm256_max_ps(
-                    slab(r.near[1], 1),
-                    _mm256_max_ps(slab(r.near[2], 2), _mm256_set1_ps(r.tmin)),
-                ),
+                nx,
+                _mm256_max_ps(ny, _mm256_max_ps(nz, _mm256_set1_ps(r.tmin))),
             );
             let t1 = _mm256_min_ps(
                 _mm256_mul_ps(
-                    _mm256_min_ps(
-                        slab(r.far[0], 0),
-                        _mm256_min_ps(slab(r.far[1], 1), slab(r.far[2], 2)),
-                    ),
+                    _mm256_min_ps(fx, _mm256_min_ps(fy, fz)),
                     _mm256_set1_ps(FAR_SCALE),
                 ),
                 _mm256_set1_ps(tmax),

@@ -35,7 +35,7 @@ pub trait Lanes16: Copy {
 #[inline(always)]
 pub fn test16<L: Lanes16>(n: &Node8, r: &BoxRay, tmax: f32) -> (u32, [f32; 8]) {
     let slab = |axis: usize| {
-        L::halves(&n.bounds[r.near[axis]], &n.bounds[r.far[axis]])
+        L::halves(&n.bounds[r.near(axis)], &n.bounds[r.far(axis)])
             .sub(L::splat(r.o[axis]))
             .mul(L::splat(r.inv[axis]))
     };

@@ -96,7 +96,7 @@ impl Rng {
         self.0 ^= self.0 >> 27;
         (self.0.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 40) as f32 / (1u64 << 24) as f32
     }
-    fn v(&mut self, lo: f32, hi: f32) -> Vec3 {
+    pub(super) fn v(&mut self, lo: f32, hi: f32) -> Vec3 {
         Vec3::new(self.f(), self.f(), self.f()) * (hi - lo) + Vec3::splat(lo)
     }
 }

@@ -45,14 +45,32 @@ fn odd_rays() -> Vec<StreamRay> {
     ]
 }
 
-/// The soup's random rays with the odd ones spread among them.
-fn rays(rng: &mut Rng) -> Vec<StreamRay> {
+/// The soup's random rays with the odd ones spread among them, and rays from the soup's
+/// vertices along directions with zero components: their origins lie on box planes, where
+/// a slab distance is 0 · ∞ = NaN and the order of `min`/`max` operands decides.
+fn rays(rng: &mut Rng, prims: &[Primitive]) -> Vec<StreamRay> {
     let mut rays: Vec<StreamRay> = random_rays(rng, 20_000)
         .into_iter()
         .map(|(_, r)| r)
         .collect();
     for (i, r) in odd_rays().into_iter().enumerate() {
         rays.insert(1 + 2_311 * i, r);
+    }
+    for k in 0..2_000 {
+        let Primitive::Triangle { v0, v1, v2 } = prims[k * 7 % prims.len()] else {
+            continue;
+        };
+        let mut d = rng.v(-1.0, 1.0);
+        d[k % 3] = if k % 2 == 0 { 0.0 } else { -0.0 };
+        if k % 5 == 0 {
+            d[(k + 1) % 3] = 0.0;
+        }
+        rays.push(StreamRay {
+            origin: [v0, v1, v2][k % 3],
+            dir: d.normalize_or(Vec3::Z),
+            tmin: if k % 4 == 0 { 0.0 } else { -1e-3 },
+            tmax: f32::INFINITY,
+        });
     }
     rays
 }
@@ -61,7 +79,7 @@ fn rays(rng: &mut Rng) -> Vec<StreamRay> {
 fn streams_match_single_rays_bit_for_bit_on_every_path() {
     let mut rng = Rng(0x5EED_0F57_AE4D_0001);
     let prims = soup(&mut rng);
-    let rays = rays(&mut rng);
+    let rays = rays(&mut rng, &prims);
     let mut accel = Accel::build(&prims);
     accel.set_simd(Simd::Sse2).unwrap();
     let single: Vec<_> = rays
@@ -108,34 +126,66 @@ fn streams_match_single_rays_bit_for_bit_on_every_path() {
     }
 }
 
+/// Streams through node test `N` with hand-overs at every node below `hot`, against the
+/// single-ray answers of `accel`.
+fn check_streams<N: node::NodeTest>(accel: &Accel, rays: &[StreamRay], hot: u32, what: &str) {
+    let w = accel.wide.as_ref().unwrap();
+    let need = accel.stack_need;
+    for len in [3, 256] {
+        let mut hits = vec![None; rays.len()];
+        let mut occ = vec![false; rays.len()];
+        for ((c, h), o) in rays
+            .chunks(len)
+            .zip(hits.chunks_mut(len))
+            .zip(occ.chunks_mut(len))
+        {
+            stream::closest_stream::<N>(w, need, hot, c, h);
+            stream::occluded_stream::<N>(w, need, hot, c, o);
+        }
+        for (k, r) in rays.iter().enumerate() {
+            let h = accel.intersect(r.origin, r.dir, r.tmin, r.tmax);
+            assert_eq!(bits(hits[k]), bits(h), "{what}, hot {hot}, {len}, ray {k}");
+            let b = accel.occluded(r.origin, r.dir, r.tmin, r.tmax);
+            assert_eq!(occ[k], b, "{what}, hot {hot}, {len}, occlusion of ray {k}");
+        }
+    }
+}
+
+#[test]
+fn every_hand_over_point_gives_the_same_answers() {
+    // The soup's tree is small: with the usual threshold every node is a top one, so the
+    // hand-overs at nodes are checked with lower ones.
+    let mut rng = Rng(0x0DD_BA11);
+    let prims = soup(&mut rng);
+    let rays = rays(&mut rng, &prims);
+    let mut accel = Accel::build(&prims);
+    accel.set_simd(Simd::Sse2).unwrap();
+    assert!(accel.wide.as_ref().unwrap().nodes.len() > 64);
+    for hot in [0, 1, 9, 64] {
+        check_streams::<node::Lanes4>(&accel, &rays, hot, "SSE2");
+    }
+}
+
 #[test]
 fn sixteen_lane_node_test_matches_on_this_cpu_as_arrays() {
     let mut rng = Rng(0xA11_1A7E5);
     let prims = soup(&mut rng);
-    let rays = rays(&mut rng);
+    let rays = rays(&mut rng, &prims);
     let mut accel = Accel::build(&prims);
     accel.set_simd(Simd::Sse2).unwrap();
+    for hot in [0, stream::HOT_NODES] {
+        check_streams::<node16::Array16>(&accel, &rays, hot, "16 lanes as arrays");
+    }
     let w = accel.wide.as_ref().unwrap();
-    let need = accel.stack_need;
-    let mut hits = vec![None; rays.len()];
-    let mut occ = vec![false; rays.len()];
-    stream::closest_stream::<node16::Array16>(w, need, &rays, &mut hits);
-    stream::occluded_stream::<node16::Array16>(w, need, &rays, &mut occ);
     for (k, r) in rays.iter().enumerate() {
-        let h = accel.intersect(r.origin, r.dir, r.tmin, r.tmax);
-        assert_eq!(bits(hits[k]), bits(h), "ray {k}");
-        assert_eq!(
-            occ[k],
-            accel.occluded(r.origin, r.dir, r.tmin, r.tmax),
-            "ray {k}"
-        );
         if !(r.origin.is_finite() && r.dir.is_finite()) {
             continue;
         }
         let d = positive_zeros(r.dir);
-        let single = traverse::with_stack(need, |s| {
+        let single = traverse::with_stack(accel.stack_need, |s| {
             traverse::closest::<node16::Array16>(w, r.origin, d, r.tmin, r.tmax, s)
         });
+        let h = accel.intersect(r.origin, r.dir, r.tmin, r.tmax);
         assert_eq!(bits(single), bits(h), "single ray {k}");
     }
 }
