@@ -2,15 +2,36 @@
 //! rays on a scene of over a million triangles (a field of tessellated spheres over a ground
 //! plane, seen by a pinhole camera), and incoherent secondary rays of `builtin:emissive-mesh`
 //! (from its camera rays' shading points: shadow rays to random points on random lights, and
-//! cosine-distributed BSDF rays traced for their closest hit).
+//! cosine-distributed BSDF rays traced for their closest hit). Each is timed one ray at a time
+//! and as streams of [`STREAM`] rays (`Accel::intersect_stream`, `Accel::occluded_stream`).
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec2, Vec3};
+use render_core::accel::{Hit, StreamRay};
 use render_core::camera::Camera;
 use render_core::frame::Frame;
 use render_core::material::Material;
 use render_core::rng::SampleStream;
 use render_core::sampling::cosine_hemisphere;
 use render_core::scene::{Scene, SceneBuilder, offset_origin};
+
+/// Rays per stream: a work unit's batch.
+const STREAM: usize = 256;
+
+/// Closest hits found tracing `rays` in streams of [`STREAM`].
+fn stream_hits(scene: &Scene, rays: &[StreamRay], hits: &mut [Option<Hit>]) -> usize {
+    for (r, h) in rays.chunks(STREAM).zip(hits.chunks_mut(STREAM)) {
+        scene.accel.intersect_stream(r, h);
+    }
+    hits.iter().filter(|h| h.is_some()).count()
+}
+
+/// Blocked rays of `rays`, traced in streams of [`STREAM`].
+fn stream_blocked(scene: &Scene, rays: &[StreamRay], blocked: &mut [bool]) -> usize {
+    for (r, b) in rays.chunks(STREAM).zip(blocked.chunks_mut(STREAM)) {
+        scene.accel.occluded_stream(r, b);
+    }
+    blocked.iter().filter(|b| **b).count()
+}
 
 /// A UV sphere mesh with `n` segments and `n/2` rings (about n² triangles).
 fn sphere_mesh(n: u32) -> (Vec<Vec3>, Vec<u32>) {
@@ -105,6 +126,18 @@ fn bench_rays(c: &mut Criterion) {
         })
         .collect();
     let light = Vec3::new(3.0, 30.0, 5.0);
+    let camera_rays: Vec<StreamRay> = rays
+        .iter()
+        .map(|d| segment(cam.position, *d, f32::INFINITY))
+        .collect();
+    let shadow_rays: Vec<StreamRay> = hits
+        .iter()
+        .map(|p| {
+            let d = light - *p;
+            let dist = d.length();
+            segment(*p, d / dist, dist)
+        })
+        .collect();
     let mut g = c.benchmark_group("rays_1M_triangles");
     g.sample_size(10);
     g.throughput(Throughput::Elements(n as u64));
@@ -132,6 +165,16 @@ fn bench_rays(c: &mut Criterion) {
                 .count()
         })
     });
+    let mut out = vec![None; camera_rays.len()];
+    g.throughput(Throughput::Elements(camera_rays.len() as u64));
+    g.bench_function("closest_hit_stream", |b| {
+        b.iter(|| stream_hits(&scene, &camera_rays, &mut out))
+    });
+    let mut blocked = vec![false; shadow_rays.len()];
+    g.throughput(Throughput::Elements(shadow_rays.len() as u64));
+    g.bench_function("shadow_stream", |b| {
+        b.iter(|| stream_blocked(&scene, &shadow_rays, &mut blocked))
+    });
     g.finish();
 }
 
@@ -140,6 +183,16 @@ struct Segment {
     o: Vec3,
     d: Vec3,
     tmax: f32,
+}
+
+/// The segment [0, tmax) of o + t·d as a ray of a stream.
+fn segment(origin: Vec3, dir: Vec3, tmax: f32) -> StreamRay {
+    StreamRay {
+        origin,
+        dir,
+        tmin: 0.0,
+        tmax,
+    }
 }
 
 /// Shadow and BSDF rays from the shading points of `builtin:emissive-mesh`'s camera rays
@@ -212,6 +265,20 @@ fn bench_incoherent(c: &mut Criterion) {
                 .filter(|r| scene.accel.occluded(r.o, r.d, 0.0, r.tmax))
                 .count()
         })
+    });
+    let streamed = |rays: &[Segment]| -> Vec<StreamRay> {
+        rays.iter().map(|r| segment(r.o, r.d, r.tmax)).collect()
+    };
+    let (bsdf, shadow) = (streamed(&bsdf), streamed(&shadow));
+    let mut out = vec![None; bsdf.len()];
+    g.throughput(Throughput::Elements(bsdf.len() as u64));
+    g.bench_function("closest_hit_stream", |b| {
+        b.iter(|| stream_hits(&scene, &bsdf, &mut out))
+    });
+    let mut blocked = vec![false; shadow.len()];
+    g.throughput(Throughput::Elements(shadow.len() as u64));
+    g.bench_function("shadow_stream", |b| {
+        b.iter(|| stream_blocked(&scene, &shadow, &mut blocked))
     });
     g.finish();
 }
