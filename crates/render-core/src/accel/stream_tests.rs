@@ -208,12 +208,10 @@ fn empty_scenes_and_streams_answer_nothing() {
     a.occluded_stream(&rays, &mut occ);
     assert!(hits.iter().all(|h| h.is_none()));
     assert!(occ.iter().all(|b| !b));
-    let mut prims = Vec::new();
-    prims.push(Primitive::Sphere {
+    let a = Accel::build(&[Primitive::Sphere {
         center: Vec3::ZERO,
         radius: 1.0,
-    });
-    let a = Accel::build(&prims);
+    }]);
     a.intersect_stream(&[], &mut []);
     a.occluded_stream(&[], &mut []);
 }
