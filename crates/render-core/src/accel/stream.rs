@@ -38,13 +38,13 @@ struct Flight {
     blocked: bool,
     /// The ray's index in the stream.
     ray: usize,
-    /// Its stack: the entries from `base`, the top at `base + sp`.
+    /// Its stack: `need` entries from `base` in the shared buffer, the top at `base + sp`.
     base: usize,
     sp: usize,
 }
 
 impl Flight {
-    /// Takes ray `ray` in place of the one done, with the root on the stack; false for a ray
+    /// Takes ray `ray` in place of the one done, with the root on `stack` (its own); false for a ray
     /// that finds nothing without a traversal (a non-finite origin or direction, as in
     /// `Accel::intersect`).
     #[inline(always)]
@@ -58,7 +58,7 @@ impl Flight {
         self.best = None;
         self.blocked = false;
         self.ray = ray;
-        stack[self.base] = MaybeUninit::new(Entry { code: 0, t: r.tmin });
+        stack[0] = MaybeUninit::new(Entry { code: 0, t: r.tmin });
         self.sp = 1;
         true
     }
@@ -78,7 +78,7 @@ impl Flight {
         stack: &mut [MaybeUninit<Entry>],
         hot: u32,
     ) -> bool {
-        let s = &mut stack[self.base..];
+        let s = stack;
         // The stack top in a register for the turn, not in `self`, which the pushes alias.
         let mut sp = self.sp;
         loop {
@@ -112,7 +112,7 @@ impl Flight {
         stack: &mut [MaybeUninit<Entry>],
         hot: u32,
     ) -> bool {
-        let s = &mut stack[self.base..];
+        let s = stack;
         let mut sp = self.sp;
         loop {
             let Some(e) = pop::<false>(s, &mut sp, self.tmax) else {
@@ -227,6 +227,9 @@ struct Flights<'a> {
     next: usize,
     live: Vec<Flight>,
     stack: Vec<MaybeUninit<Entry>>,
+    /// Entries of each ray's stack: its slice of `stack`, so that an overflow panics as in
+    /// the single-ray traversal instead of reaching the next ray's.
+    need: usize,
     /// Nodes below this index (the top levels, stored first) are tested without a turn.
     hot: u32,
 }
@@ -246,6 +249,7 @@ impl<'a> Flights<'a> {
             next: 0,
             live: Vec::with_capacity(n),
             stack: vec![MaybeUninit::uninit(); n * need],
+            need,
             hot,
         };
         for slot in 0..n {
@@ -273,7 +277,12 @@ impl<'a> Flights<'a> {
         while self.next < self.rays.len() {
             let i = self.next;
             self.next += 1;
-            if self.live[k].start(&self.rays[i], i, &mut self.stack) {
+            let r = &mut self.live[k];
+            if r.start(
+                &self.rays[i],
+                i,
+                &mut self.stack[r.base..r.base + self.need],
+            ) {
                 return true;
             }
             answer(i, None);
@@ -292,7 +301,8 @@ impl<'a> Flights<'a> {
         while !self.live.is_empty() {
             let mut k = 0;
             while k < self.live.len() {
-                if turn(&mut self.live[k], &mut self.stack, self.hot) {
+                let r = &mut self.live[k];
+                if turn(r, &mut self.stack[r.base..r.base + self.need], self.hot) {
                     answer(self.live[k].ray, Some(&self.live[k]));
                     if !self.admit(k, answer) {
                         self.live.swap_remove(k);
