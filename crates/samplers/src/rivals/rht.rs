@@ -56,7 +56,7 @@
 //! valid RIS integrand; where P_D > 0 every step on ℓ's path has q ≥ p > 0, so π > 0 and the
 //! candidates cover every y with w_R(y) > 0; elsewhere w_R = 0 and BSDF sampling takes it all.
 use super::rht_gather::{Gathered, Traversal, Visit};
-use super::rht_nodes::{RhtNodes, zero_split_bound};
+use super::rht_nodes::{NodeWeights, RhtNodes, zero_split_bound};
 pub use super::rht_options::{DEFAULT_PICKS, DEFAULT_TAU, MAX_PICKS, RhtOptions, RhtTraversal};
 use super::slc_bo::BoWeight;
 use crate::bsdf_sampling::sample_bsdf;
@@ -66,7 +66,7 @@ use crate::scratch::Pooled;
 use crate::strategy::Strategy;
 use crate::tree_selection::{PowerUnits, light_bounds};
 use brdf_integrals::Sptd;
-use light_tree::{LightTree, NodeId};
+use light_tree::LightTree;
 use render_core::Vec3;
 use render_core::colour::luminance;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
@@ -174,43 +174,6 @@ crate::scratch_pool!(RhtScratch, |s| {
     s.candidates.clear();
     s.weights.clear();
 });
-
-/// The node weights of one shading point: the tree's importance, or the BO weight.
-pub enum NodeWeights {
-    /// E&K importance at (x, n), on the tree's compact bounds.
-    Tree(Vec3, Vec3),
-    /// `rht-bo`'s weight at a glossy point.
-    Bo(BoWeight),
-}
-
-impl NodeWeights {
-    /// The weights of the two children of interior node `id`, whose compact pair is `pair`.
-    pub fn children(&self, tree: &LightTree, id: NodeId, pair: u32) -> [f32; 2] {
-        match self {
-            NodeWeights::Tree(x, n) => tree.pair_child_importances(pair, *x, *n),
-            NodeWeights::Bo(bo) => match tree.node(id).children(id) {
-                Some((l, r)) => [bo.weight(tree.node(l)), bo.weight(tree.node(r))],
-                None => [0.0; 2],
-            },
-        }
-    }
-
-    /// [`NodeWeights::children`] and, where one evaluation gives them at no extra cost (the
-    /// tree's importance, eight lanes at a time), the weights of the children's own children
-    /// (`None` for a leaf or where not evaluated).
-    #[inline]
-    pub fn children_ahead(
-        &self,
-        tree: &LightTree,
-        id: NodeId,
-        pair: u32,
-    ) -> ([f32; 2], [Option<[f32; 2]>; 2]) {
-        match self {
-            NodeWeights::Tree(x, n) => tree.pair_child_importances_ahead(pair, *x, *n),
-            NodeWeights::Bo(_) => (self.children(tree, id, pair), [None; 2]),
-        }
-    }
-}
 
 /// The resampled hierarchical tree as a strategy.
 pub struct Rht {

@@ -43,7 +43,7 @@
 //! * each candidate carries its single-descent pmf (Π p on its path), which the MIS weight of
 //!   the picked candidate needs, multiplied up with the same operations as
 //!   [`Traversal::descent_pmf`], so it equals that replay bit for bit without a second walk.
-use super::rht::NodeWeights;
+use super::rht_nodes::NodeWeights;
 use super::rht_nodes::{Kind, RhtNodes};
 use light_tree::{LightTree, NodeId};
 use render_core::rng::SampleStream;

@@ -10,6 +10,7 @@
 //! requested while the current node is worked on, and the split probability is computed
 //! inline with the same operations as [`LightTree::split_sigma`], so every value, and so the
 //! image, stays the same bit for bit.
+use super::slc_bo::BoWeight;
 use light_tree::{LightTree, NodeId};
 use render_core::Vec3;
 
@@ -217,5 +218,42 @@ mod tests {
             seen.iter().all(|&k| k > 100),
             "outcomes 0, 1, between: {seen:?}"
         );
+    }
+}
+
+/// The node weights of one shading point: the tree's importance, or the BO weight.
+pub enum NodeWeights {
+    /// E&K importance at (x, n), on the tree's compact bounds.
+    Tree(Vec3, Vec3),
+    /// `rht-bo`'s weight at a glossy point.
+    Bo(BoWeight),
+}
+
+impl NodeWeights {
+    /// The weights of the two children of interior node `id`, whose compact pair is `pair`.
+    pub fn children(&self, tree: &LightTree, id: NodeId, pair: u32) -> [f32; 2] {
+        match self {
+            NodeWeights::Tree(x, n) => tree.pair_child_importances(pair, *x, *n),
+            NodeWeights::Bo(bo) => match tree.node(id).children(id) {
+                Some((l, r)) => [bo.weight(tree.node(l)), bo.weight(tree.node(r))],
+                None => [0.0; 2],
+            },
+        }
+    }
+
+    /// [`NodeWeights::children`] and, where one evaluation gives them at no extra cost (the
+    /// tree's importance, eight lanes at a time), the weights of the children's own children
+    /// (`None` for a leaf or where not evaluated).
+    #[inline]
+    pub fn children_ahead(
+        &self,
+        tree: &LightTree,
+        id: NodeId,
+        pair: u32,
+    ) -> ([f32; 2], [Option<[f32; 2]>; 2]) {
+        match self {
+            NodeWeights::Tree(x, n) => tree.pair_child_importances_ahead(pair, *x, *n),
+            NodeWeights::Bo(_) => (self.children(tree, id, pair), [None; 2]),
+        }
     }
 }
