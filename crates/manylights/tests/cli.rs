@@ -38,12 +38,17 @@ fn temp_dir(name: &str) -> TempDir {
 const SCENE: &str = "builtin:glossy-spheres?lights=64";
 
 fn render_to(dir: &Path, name: &str, extra: &[&str]) -> Output {
+    render_strategy_to(dir, name, "power+bsdf", extra)
+}
+
+/// [`render_to`] with another strategy.
+fn render_strategy_to(dir: &Path, name: &str, strategy: &str, extra: &[&str]) -> Output {
     let out = dir.join(format!("{name}.exr"));
     let mut args = vec![
         "render",
         SCENE,
         "--strategy",
-        "power+bsdf",
+        strategy,
         "--spp",
         "2",
         "--width",
@@ -159,24 +164,7 @@ fn engine_flag_leaves_the_image_alone_and_is_recorded() {
         ("batched", "mis3-adaptive", "per-sample"),
     ] {
         let name = format!("{engine}-{}", strategy.replace('+', "_"));
-        let out = dir.join(format!("{name}.exr"));
-        let o = manylights(&[
-            "render",
-            SCENE,
-            "--strategy",
-            strategy,
-            "--engine",
-            engine,
-            "--spp",
-            "2",
-            "--width",
-            "32",
-            "--height",
-            "24",
-            "--quiet",
-            "--out",
-            out.to_str().unwrap(),
-        ]);
+        let o = render_strategy_to(&dir, &name, strategy, &["--engine", engine]);
         assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
         let json = std::fs::read_to_string(dir.join(format!("{name}.json"))).unwrap();
         let meta: serde_json::Value = serde_json::from_str(&json).unwrap();
