@@ -232,8 +232,21 @@ fn image_space_strategy_keeps_its_budget_and_records_its_memory() {
         meta["image_space_bytes_per_pixel"].as_u64().unwrap() > 0,
         "{meta}"
     );
+    assert_eq!(meta["passes_correlated"], false, "{meta}");
+    let carried = render_with_budget(
+        &dir,
+        "0.3",
+        &["--strategy", "restir", "--restir-history", "20"],
+    );
+    assert_eq!(carried["passes_correlated"], true, "{carried}");
+    assert!(
+        carried["image_space_bytes_per_pixel"].as_u64()
+            > meta["image_space_bytes_per_pixel"].as_u64(),
+        "the history's memory is counted: {carried}"
+    );
     let plain = render_with_budget(&dir, "0.1", &[]);
     assert!(plain["image_space_bytes_per_pixel"].is_null());
+    assert_eq!(plain["passes_correlated"], false);
     let bad = temp_dir("image-space-bad");
     let out = bad.join("bad.exr");
     assert_clean_failure(

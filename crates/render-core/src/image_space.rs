@@ -13,7 +13,11 @@
 //! pass is never cut short; another starts while at least half of the last one's time is
 //! left, so the budget is missed by at most half a pass either way), a strategy's per-pixel
 //! memory and pilot are not offered, and the passes' pixels are no longer independent (a
-//! pixel's estimate uses its neighbours' samples of the same pass; passes stay independent).
+//! pixel's estimate uses its neighbours' samples of the same pass). Passes stay independent
+//! unless the strategy carries state from one pass to the next ([`PassCarry`]; ReSTIR's reuse
+//! of the previous pass's reservoirs), which it then declares with
+//! [`ImageSpaceLighting::correlates_passes`]: the per-pixel variance of such a render's passes
+//! no longer estimates its error.
 use crate::rng::SampleStream;
 use crate::scene::Scene;
 use crate::shading_point::ShadingPoint;
@@ -26,14 +30,28 @@ use std::sync::Mutex;
 /// Pixels a worker takes at a time in a phase.
 const CHUNK: usize = 256;
 
+/// What a strategy hands from one pass to the next: empty before the first pass; the render
+/// loop keeps it between passes and never looks inside.
+pub type PassCarry = Option<Box<dyn std::any::Any + Send + Sync>>;
+
 /// A strategy's direct lighting of a whole pass.
 pub trait ImageSpaceLighting: Sync {
     /// Every pixel's direct-lighting estimate and its diagnostic values (the channels of
     /// `DirectLighting::aux_channels`), in pixel order; zero where `pass.points` has none.
-    fn estimate_image(&self, pass: &ImagePass) -> Vec<(Vec3, [f32; MAX_AUX])>;
-    /// Bytes it holds per pixel while a pass runs (its buffers), for the memory check and the
-    /// render's record.
+    /// `carry` is what the previous pass of this render left (empty for the first).
+    fn estimate_image(
+        &self,
+        pass: &ImagePass,
+        carry: &mut PassCarry,
+    ) -> Vec<(Vec3, [f32; MAX_AUX])>;
+    /// Bytes it holds per pixel while a pass runs (its buffers, and what it carries to the
+    /// next pass), for the memory check and the render's record.
     fn bytes_per_pixel(&self) -> usize;
+    /// Whether a pass's estimates depend on earlier passes' samples (through `carry`): the
+    /// passes are then correlated and their spread understates the error.
+    fn correlates_passes(&self) -> bool {
+        false
+    }
 }
 
 /// One pass over the image, as a strategy's phases see it.

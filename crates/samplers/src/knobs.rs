@@ -399,6 +399,16 @@ pub static KNOBS: &[Knob] = &[
         },
     },
     Knob {
+        flag: "restir-history",
+        help: "ReSTIR: reuse each pixel's reservoir of the previous pass, its confidence capped at this many times the pixel's new candidates (the paper's temporal reuse: 20); 0 (default): none, passes independent. Passes are then correlated: the render's variance no longer estimates its error.",
+        kind: KnobKind::Number,
+        value: |o| o.reuse.history.to_string(),
+        set: |o, s| {
+            o.reuse.history = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
         flag: "rht-tau",
         help: "Resampled hierarchical tree: a node whose E&K variance measure ρ is below τ is split (both children gathered) with probability 1 − ρ/τ, in (0, 1].",
         kind: KnobKind::Number,

@@ -203,3 +203,62 @@ fn the_reservoir_keeps_candidates_in_proportion_to_their_weights() {
         "chi-square {out:?}: {counts:?} vs {expected:?}"
     );
 }
+
+/// Reuse across passes (`--restir-history`) keeps the image unbiased: the previous pass's
+/// reservoir is one more domain of the pairwise weights, its confidence capped. Renders of 4
+/// passes, so that three of them reuse.
+#[test]
+fn reuse_across_passes_converges_to_the_image_of_power_bsdf() {
+    let scene = common::mixed_scene(20);
+    let reference = reference(&scene);
+    let with_history = |candidates, history| ReuseConfig {
+        candidates,
+        history,
+        ..Default::default()
+    };
+    for (name, reuse) in [
+        ("restir", with_history(4, 20.0)),
+        ("restir", with_history(2, 1000.0)),
+        ("restir-bo", with_history(4, 20.0)),
+    ] {
+        let z = z_scores(&scene, name, &opts(reuse.clone()), &reference, (16, 4));
+        eprintln!("{name} {reuse:?}: z = {z:.2?}");
+        assert!(
+            z.iter().all(|z| z.abs() <= Z),
+            "{name} {reuse:?}: z = {z:.2?}"
+        );
+    }
+}
+
+/// The first pass has no history, so it is the same with and without; later passes reuse it
+/// (other bytes), the same on 1 and 2 threads.
+#[test]
+fn reuse_across_passes_starts_at_the_second_pass_and_is_deterministic() {
+    let scene = common::mixed_scene(10);
+    let on = opts(ReuseConfig {
+        history: 20.0,
+        ..Default::default()
+    });
+    let off = StrategyOptions::default();
+    for name in ["restir", "restir-biased", "restir-bo"] {
+        let first_on = common::render_opts(&scene, name, &on, 1, 2, 7, None);
+        let first_off = common::render_opts(&scene, name, &off, 1, 2, 7, None);
+        assert_eq!(first_on.pixels, first_off.pixels, "{name}: first pass");
+        let a = common::render_opts(&scene, name, &on, 3, 1, 7, None);
+        let b = common::render_opts(&scene, name, &on, 3, 2, 7, None);
+        let plain = common::render_opts(&scene, name, &off, 3, 2, 7, None);
+        assert_eq!(a.pixels, b.pixels, "{name}: 1 and 2 threads differ");
+        assert_ne!(a.pixels, plain.pixels, "{name}: the history was not used");
+    }
+}
+
+#[test]
+fn a_bad_history_cap_is_refused() {
+    for history in [-1.0, f32::NAN, 1e6] {
+        let reuse = ReuseConfig {
+            history,
+            ..Default::default()
+        };
+        assert!(reuse.check().is_err(), "{history} accepted");
+    }
+}

@@ -98,7 +98,7 @@ pub(super) fn metadata(
     let (filter, filter_from) = &choices.filter;
     let (reconstruction, reconstruction_from) = choices.reconstruction;
     let budget_clock = |c: BudgetClockArg| format!("{c:?}").to_lowercase();
-    serde_json::json!({
+    let mut meta = serde_json::json!({
         "scene": args.scene,
         "scene_stats": scene.stats,
         "scene_hash": scene.content_hash(),
@@ -146,7 +146,14 @@ pub(super) fn metadata(
         "png_exposure_auto": args.png.as_ref().map(|_| args.exposure.is_none()),
         "version": env!("CARGO_PKG_VERSION"),
         "git_commit": option_env!("MANYLIGHTS_GIT_COMMIT").filter(|s| !s.is_empty()),
-    })
+    });
+    // Whether passes share samples (ReSTIR's reuse across passes): the per-pixel variance of
+    // the passes then understates the error.
+    meta["passes_correlated"] = strategy
+        .image_space()
+        .is_some_and(|s| s.correlates_passes())
+        .into();
+    meta
 }
 
 /// The one-line summary: spp, passes, seconds and ray throughput.

@@ -72,7 +72,7 @@ impl Passes {
             pool,
             counters: Mutex::new(Counters::default()),
         };
-        let direct = strategy.estimate_image(&pass);
+        let direct = strategy.estimate_image(&pass, &mut self.carry);
         if direct.len() != n {
             return Err(format!(
                 "strategy {}: its image-space pass returned {} pixels, not {n}",

@@ -23,6 +23,8 @@ pub(super) struct Passes {
     pub(super) weights: Vec<f64>,
     /// Pixels with one sample more than `spp_done` (a budget spent inside a pass).
     pub(super) partial_pixels: usize,
+    /// What an image-space strategy hands from one pass to the next.
+    pub(super) carry: crate::image_space::PassCarry,
 }
 
 /// A pass's work units, each claimed by one worker thread.
@@ -46,6 +48,7 @@ impl Passes {
             passes: 0,
             weights: Vec::new(),
             partial_pixels: 0,
+            carry: None,
         }
     }
 

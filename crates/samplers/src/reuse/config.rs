@@ -46,6 +46,10 @@ pub struct ReuseConfig {
     pub radius: f32,
     /// Rounds of spatial reuse (the paper's 2).
     pub rounds: u32,
+    /// Reuse of each pixel's final reservoir of the previous pass, its confidence capped at
+    /// this many times the pixel's new candidates (the paper's temporal reuse caps at 20); 0:
+    /// none, so that passes are independent (the default, a still image's honest variance).
+    pub history: f32,
 }
 
 impl Default for ReuseConfig {
@@ -56,6 +60,7 @@ impl Default for ReuseConfig {
             neighbours: 5,
             radius: 30.0,
             rounds: 2,
+            history: 0.0,
         }
     }
 }
@@ -87,9 +92,18 @@ impl ReuseConfig {
                 self.rounds
             ));
         }
+        if !(0.0..=MAX_HISTORY).contains(&self.history) {
+            return Err(format!(
+                "--restir-history must be 0 (off) to {MAX_HISTORY}, got {}",
+                self.history
+            ));
+        }
         Ok(())
     }
 }
+
+/// Largest cap on the previous pass's confidence, in multiples of a pixel's new candidates.
+pub const MAX_HISTORY: f32 = 1000.0;
 
 /// Most neighbours per round.
 pub const MAX_NEIGHBOURS: usize = 32;

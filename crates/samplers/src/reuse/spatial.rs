@@ -21,6 +21,7 @@ use render_core::Vec3;
 use render_core::estimator::ShadingPoint;
 use render_core::image_space::ImagePass;
 use render_core::rng::SampleStream;
+use render_core::scene::Scene;
 use render_core::stats::Counters;
 
 /// Index of the neighbours' samples the pixel sees (and reflects) in the technique counters.
@@ -43,7 +44,6 @@ pub fn neighbours(
     out.clear();
     let Some(sp) = &pass.points[i] else { return };
     let (x, y) = ((i % pass.width) as f32, (i / pass.width) as f32);
-    let depth = (sp.point() - pass.camera_position).length();
     for _ in 0..n.min(MAX_NEIGHBOURS as u32) {
         let u = rng.next_2d();
         let r = radius * u.x.sqrt();
@@ -57,20 +57,25 @@ pub fn neighbours(
             continue;
         }
         let Some(sq) = &pass.points[q] else { continue };
-        let dq = (sq.point() - pass.camera_position).length();
-        if sq.hit.ns.dot(sp.hit.ns) >= MIN_NORMAL_COS
-            && (dq - depth).abs() <= MAX_DEPTH_RATIO * depth
-        {
+        if alike(sp, sq, pass.camera_position) {
             out.push(q);
         }
     }
 }
 
+/// Whether shading point `sq` is like `sp` seen from `camera` (normal within 25°, depth within
+/// 10%): the paper's test for a neighbour worth reusing.
+pub fn alike(sp: &ShadingPoint, sq: &ShadingPoint, camera: Vec3) -> bool {
+    let depth = (sp.point() - camera).length();
+    let dq = (sq.point() - camera).length();
+    sq.hit.ns.dot(sp.hit.ns) >= MIN_NORMAL_COS && (dq - depth).abs() <= MAX_DEPTH_RATIO * depth
+}
+
 /// p̂·V of `sp` at `r`'s sample: 0 where the target is 0 or the point is hidden (one shadow ray
 /// where the target is not 0).
-fn seen_target(pass: &ImagePass, sp: &ShadingPoint, r: &Reservoir, c: &mut Counters) -> f32 {
-    match target(pass.scene, sp, &r.y) {
-        Some((p, _, seen)) if !occluded(pass.scene, sp, &r.y, &seen, c) => p,
+fn seen_target(scene: &Scene, sp: &ShadingPoint, r: &Reservoir, c: &mut Counters) -> f32 {
+    match target(scene, sp, &r.y) {
+        Some((p, _, seen)) if !occluded(scene, sp, &r.y, &seen, c) => p,
         _ => 0.0,
     }
 }
@@ -95,40 +100,55 @@ pub fn pairwise_round(
     rng: &mut SampleStream,
     c: &mut Counters,
 ) -> Reservoir {
-    let r0 = prev[i];
     let Some(sp0) = &pass.points[i] else {
-        return r0;
+        return prev[i];
     };
-    if nbrs.is_empty() {
+    let others: Vec<(Reservoir, &ShadingPoint)> = nbrs
+        .iter()
+        .map(|&j| {
+            let spj = pass.points[j].as_ref();
+            (prev[j], spj.expect("neighbours have shading points"))
+        })
+        .collect();
+    pairwise_resample(pass.scene, (prev[i], sp0), &others, rng, c)
+}
+
+/// GRIS with pairwise MIS weights: the canonical reservoir `r0` of shading point `sp0` and
+/// the reservoirs `others` of other shading points (neighbours, or the pixel's own of the
+/// previous pass), each with its confidence, resampled into one reservoir for `sp0`.
+pub fn pairwise_resample(
+    scene: &Scene,
+    (r0, sp0): (Reservoir, &ShadingPoint),
+    others: &[(Reservoir, &ShadingPoint)],
+    rng: &mut SampleStream,
+    c: &mut Counters,
+) -> Reservoir {
+    if others.is_empty() {
         return r0;
     }
-    let k = nbrs.len() as f32;
+    let k = others.len() as f32;
     let c0k = r0.c / k;
-    let total = r0.c + nbrs.iter().map(|&j| prev[j].c).sum::<f32>();
+    let total = r0.c + others.iter().map(|(r, _)| r.c).sum::<f32>();
     // The pixel's own sample is visible from it whenever W > 0 (every phase keeps only such).
     let p0_y0 = if r0.w > 0.0 {
-        target(pass.scene, sp0, &r0.y).map_or(0.0, |t| t.0)
+        target(scene, sp0, &r0.y).map_or(0.0, |t| t.0)
     } else {
         0.0
     };
     let mut stream = Stream::default();
     let mut m0 = 0.0;
-    for &j in nbrs {
-        let rj = prev[j];
-        let spj = pass.points[j]
-            .as_ref()
-            .expect("neighbours have shading points");
+    for &(rj, spj) in others {
         let pair = (rj.c + c0k) / total;
         if p0_y0 > 0.0 {
-            let pj_y0 = seen_target(pass, spj, &r0, c);
+            let pj_y0 = seen_target(scene, spj, &r0, c);
             m0 += pair_weights(pair, (rj.c, pj_y0), (c0k, p0_y0)).1;
         }
         let u = rng.next_f32();
         if !(rj.w > 0.0) {
             continue;
         }
-        let pj_yj = target(pass.scene, spj, &rj.y).map_or(0.0, |t| t.0);
-        let p0_yj = seen_target(pass, sp0, &rj, c);
+        let pj_yj = target(scene, spj, &rj.y).map_or(0.0, |t| t.0);
+        let p0_yj = seen_target(scene, sp0, &rj, c);
         if pj_yj > 0.0 && p0_yj > 0.0 {
             c.technique_samples[TECHNIQUE_SEEN] += 1;
             let mj = pair_weights(pair, (rj.c, pj_yj), (c0k, p0_yj)).0;
@@ -150,20 +170,31 @@ pub fn biased_round(
     nbrs: &[usize],
     rng: &mut SampleStream,
 ) -> Reservoir {
-    let r0 = prev[i];
     let Some(sp0) = &pass.points[i] else {
-        return r0;
+        return prev[i];
     };
+    let others: Vec<Reservoir> = nbrs.iter().map(|&j| prev[j]).collect();
+    biased_resample(pass.scene, (prev[i], sp0), &others, rng)
+}
+
+/// The paper's 1/M combination of the canonical reservoir `r0` of `sp0` and reservoirs
+/// `others`: unshadowed targets at `sp0`, weights c_j / C (biased where the others' shading
+/// points see or reflect differently).
+pub fn biased_resample(
+    scene: &Scene,
+    (r0, sp0): (Reservoir, &ShadingPoint),
+    others: &[Reservoir],
+    rng: &mut SampleStream,
+) -> Reservoir {
     let mut stream = Stream::default();
     let mut total = 0.0;
-    for &j in std::iter::once(&i).chain(nbrs) {
-        let r = prev[j];
+    for &r in std::iter::once(&r0).chain(others) {
         total += r.c;
         let u = rng.next_f32();
         if !(r.w > 0.0) {
             continue;
         }
-        let p0 = target(pass.scene, sp0, &r.y).map_or(0.0, |t| t.0);
+        let p0 = target(scene, sp0, &r.y).map_or(0.0, |t| t.0);
         stream.offer(r.y, p0 * r.w * r.c, p0, u);
     }
     let mut r = stream.finish(total);

@@ -4,7 +4,8 @@
 //!
 //! Parameters (`--restir-*`, [`ReuseConfig`]): candidates M (32), their source (`power`, or
 //! `tree`: one light-tree descent), neighbours per round (5), their radius in pixels (30),
-//! rounds (2). Where it differs from the paper: no temporal reuse (each pass is an
+//! rounds (2), reuse of the previous pass's reservoirs (`--restir-history CAP`, off; see
+//! `history`). Where it differs from the paper: no temporal reuse by default (each pass is an
 //! independent estimate of a still image, so passes average without correlation); samples are
 //! points in the lights' area measure, so reuse needs no Jacobian; the unbiased combination
 //! uses the pairwise MIS weights of GRIS (Lin et al. 2022) with the shadow rays they need
@@ -18,6 +19,7 @@
 //! `estimate` alone (a single shading point, no neighbours) is the initial reservoir's
 //! estimate: unbiased RIS with M + 1 candidates, used by tools that shade single points.
 use super::config::{CandidateSourceKind, ReuseConfig};
+use super::history::{HISTORY_PHASE, History};
 use super::light_point::{occluded, target};
 use super::reservoir::Reservoir;
 use super::sources::{FromBo, FromSelection, InitialSource};
@@ -31,7 +33,7 @@ use crate::tree_selection::{TreeMode, TreeSelection};
 use crate::{StrategyError, StrategyOptions};
 use render_core::Vec3;
 use render_core::estimator::{DirectLighting, MAX_AUX, SampleContext, ShadingPoint};
-use render_core::image_space::{ImagePass, ImageSpaceLighting};
+use render_core::image_space::{ImagePass, ImageSpaceLighting, PassCarry};
 use render_core::rng::SampleStream;
 use render_core::scene::Scene;
 use render_core::stats::Counters;
@@ -111,12 +113,22 @@ impl DirectLighting for ReStir {
 }
 
 impl ImageSpaceLighting for ReStir {
-    fn estimate_image(&self, pass: &ImagePass) -> Vec<(Vec3, [f32; MAX_AUX])> {
+    fn estimate_image(
+        &self,
+        pass: &ImagePass,
+        carry: &mut PassCarry,
+    ) -> Vec<(Vec3, [f32; MAX_AUX])> {
         let mut cur: Vec<Reservoir> = pass.run(0, |i, rng, c| match &pass.points[i] {
             Some(sp) => self.visible_initial(pass.scene, sp, rng, c),
             None => Reservoir::default(),
         });
         let cfg = &self.config;
+        if let Some(h) = History::of(pass, carry).filter(|_| cfg.history > 0.0) {
+            let first = cur;
+            cur = pass.run(HISTORY_PHASE, |i, rng, c| {
+                h.reuse(pass, (&first, i), (cfg.history, !self.biased), rng, c)
+            });
+        }
         for round in 0..cfg.rounds {
             let prev = cur;
             cur = pass.run(1 + round, |i, rng, c| {
@@ -130,17 +142,30 @@ impl ImageSpaceLighting for ReStir {
                 }
             });
         }
-        pass.run(cfg.rounds + 1, |i, _, c| {
+        let out = pass.run(cfg.rounds + 1, |i, _, c| {
             let l = match &pass.points[i] {
                 Some(sp) => shade(pass, sp, &cur[i], !self.biased, c),
                 None => Vec3::ZERO,
             };
             (l, [0.0; MAX_AUX])
-        })
+        });
+        if cfg.history > 0.0 {
+            History::keep(pass, cur, carry);
+        }
+        out
     }
 
     fn bytes_per_pixel(&self) -> usize {
-        2 * size_of::<Reservoir>()
+        let history = if self.config.history > 0.0 {
+            size_of::<Reservoir>() + size_of::<Option<ShadingPoint>>()
+        } else {
+            0
+        };
+        2 * size_of::<Reservoir>() + history
+    }
+
+    fn correlates_passes(&self) -> bool {
+        self.config.history > 0.0
     }
 }
 
@@ -219,6 +244,7 @@ const KNOBS: &[&str] = &[
     "restir-neighbours",
     "restir-radius",
     "restir-rounds",
+    "restir-history",
 ];
 
 const BO_KNOBS: &[&str] = &[
@@ -226,6 +252,7 @@ const BO_KNOBS: &[&str] = &[
     "restir-neighbours",
     "restir-radius",
     "restir-rounds",
+    "restir-history",
     "delta",
     "max-cut",
     "brdf-integral",
