@@ -354,6 +354,16 @@ pub static KNOBS: &[Knob] = &[
         },
     },
     Knob {
+        flag: "restir-bo-candidates",
+        help: "ReSTIR BO: candidates per pixel from the paper's techniques (BO + tree at glossy points), resampled with one BSDF candidate into the pixel's first reservoir.",
+        kind: KnobKind::Number,
+        value: |o| o.reuse.bo_candidates.to_string(),
+        set: |o, s| {
+            o.reuse.bo_candidates = number(s)?;
+            Ok(())
+        },
+    },
+    Knob {
         flag: "restir-source",
         help: "ReSTIR: where the light candidates come from, `power` (lights by power, as the paper) or `tree` (one light-tree descent).",
         kind: KnobKind::Choice(|| {

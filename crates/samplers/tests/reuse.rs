@@ -92,10 +92,11 @@ fn restir_converges_to_the_image_of_power_bsdf() {
             },
         ),
         ("restir", ReuseConfig { rounds: 0, ..d() }),
+        ("restir-bo", d()),
         (
             "restir-bo",
             ReuseConfig {
-                candidates: 8,
+                bo_candidates: 16,
                 ..d()
             },
         ),
@@ -253,12 +254,22 @@ fn reuse_across_passes_starts_at_the_second_pass_and_is_deterministic() {
 }
 
 #[test]
-fn a_bad_history_cap_is_refused() {
+fn bad_reuse_parameters_are_refused() {
     for history in [-1.0, f32::NAN, 1e6] {
         let reuse = ReuseConfig {
             history,
             ..Default::default()
         };
-        assert!(reuse.check().is_err(), "{history} accepted");
+        assert!(reuse.check().is_err(), "history {history} accepted");
+    }
+    for bo_candidates in [0, 5000] {
+        let reuse = ReuseConfig {
+            bo_candidates,
+            ..Default::default()
+        };
+        assert!(
+            reuse.check().is_err(),
+            "{bo_candidates} BO candidates accepted"
+        );
     }
 }

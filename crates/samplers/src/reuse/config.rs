@@ -36,8 +36,13 @@ impl CandidateSourceKind {
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(default)]
 pub struct ReuseConfig {
-    /// Light candidates per pixel (M; the paper's 32), plus one BSDF candidate.
+    /// Light candidates per pixel (M; the paper's 32), plus one BSDF candidate (`restir`,
+    /// `restir-biased`).
     pub candidates: u32,
+    /// `restir-bo`'s candidates per pixel (BO + tree), plus one BSDF candidate: fewer than
+    /// `restir`'s, since each is drawn from the BRDF-aware mixture and the BO cut is the cost
+    /// (measured: docs/notes/reuse.md).
+    pub bo_candidates: u32,
     /// Where the light candidates come from.
     pub source: CandidateSourceKind,
     /// Neighbours per round of spatial reuse (the paper's 5).
@@ -56,6 +61,7 @@ impl Default for ReuseConfig {
     fn default() -> Self {
         ReuseConfig {
             candidates: 32,
+            bo_candidates: 4,
             source: CandidateSourceKind::Power,
             neighbours: 5,
             radius: 30.0,
@@ -66,12 +72,26 @@ impl Default for ReuseConfig {
 }
 
 impl ReuseConfig {
+    /// The parameters `restir-bo` runs with: its own candidate count as `candidates`.
+    pub fn for_bo(&self) -> ReuseConfig {
+        ReuseConfig {
+            candidates: self.bo_candidates,
+            ..self.clone()
+        }
+    }
+
     /// Refuses values outside what the strategies take.
     pub fn check(&self) -> Result<(), String> {
         if !(1..=1024).contains(&self.candidates) {
             return Err(format!(
                 "--restir-candidates must be 1 to 1024, got {}",
                 self.candidates
+            ));
+        }
+        if !(1..=1024).contains(&self.bo_candidates) {
+            return Err(format!(
+                "--restir-bo-candidates must be 1 to 1024, got {}",
+                self.bo_candidates
             ));
         }
         if self.neighbours > MAX_NEIGHBOURS as u32 {

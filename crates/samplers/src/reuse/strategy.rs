@@ -11,7 +11,8 @@
 //! uses the pairwise MIS weights of GRIS (Lin et al. 2022) with the shadow rays they need
 //! instead of the paper's 1/Z count, which `restir-biased`'s 1/M form drops.
 //!
-//! `restir-bo` draws its candidates with the paper's techniques instead (`sources::FromBo`):
+//! `restir-bo` draws its candidates (`--restir-bo-candidates`, 4) with the paper's techniques
+//! instead (`sources::FromBo`):
 //! at glossy points half BRDF-oriented samples from the BO cut and half light-tree samples
 //! (a fixed split, where the paper's allocation adapts it), tree samples elsewhere, their
 //! mixture density in every candidate's weight, so a neighbour reuses a glossy pixel's BO sample.
@@ -169,12 +170,25 @@ impl ImageSpaceLighting for ReStir {
     }
 }
 
+/// The reuse parameters strategy `name` runs with.
+fn config(name: &str, opts: &StrategyOptions) -> ReuseConfig {
+    if name == RESTIR_BO.name {
+        opts.reuse.for_bo()
+    } else {
+        opts.reuse.clone()
+    }
+}
+
 fn resolve(name: &str, opts: &StrategyOptions) -> serde_json::Value {
     let mut v = serde_json::json!({
-        "reuse": opts.reuse,
+        "reuse": config(name, opts),
         "biased": name == RESTIR_BIASED.name,
         "power_units": crate::resolve::units(opts),
     });
+    // Each strategy reads one of the two counts, as `candidates`.
+    if let Some(reuse) = v["reuse"].as_object_mut() {
+        reuse.remove("bo_candidates");
+    }
     if name == RESTIR_BO.name {
         v["reuse"]["source"] = "tree+bo".into();
         v["delta"] = opts.delta.into();
@@ -207,7 +221,7 @@ fn source(
                 name: RESTIR_BO.name.into(),
                 tree,
                 integral,
-                count: CandidateCount::Fixed(opts.reuse.candidates),
+                count: CandidateCount::Fixed(opts.reuse.bo_candidates),
                 delta: opts.delta,
                 max_cut: opts.max_cut,
             }
@@ -233,7 +247,7 @@ fn build(
     Ok(Box::new(ReStir {
         name: name.into(),
         source: source(name, scene, opts)?,
-        config: opts.reuse.clone(),
+        config: config(name, opts),
         biased: name == RESTIR_BIASED.name,
     }))
 }
@@ -248,7 +262,7 @@ const KNOBS: &[&str] = &[
 ];
 
 const BO_KNOBS: &[&str] = &[
-    "restir-candidates",
+    "restir-bo-candidates",
     "restir-neighbours",
     "restir-radius",
     "restir-rounds",
@@ -288,7 +302,7 @@ pub const RESTIR_BO: Strategy = Strategy {
     golden_variants: &["ltc"],
     ..Strategy::new(
         "restir-bo",
-        "restir whose candidates are Liu et al.'s: BRDF-oriented (BO cut) + light-tree samples at glossy points, tree samples elsewhere, + 1 BSDF; shared between pixels",
+        "restir whose 4 candidates are Liu et al.'s: BRDF-oriented (BO cut) + light-tree samples at glossy points, tree samples elsewhere, + 1 BSDF; shared between pixels",
         resolve,
         build,
     )
