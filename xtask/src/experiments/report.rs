@@ -227,6 +227,30 @@ pub fn format_time_table(
     cols: &[String],
     entries: &BTreeMap<(String, String), Entry>,
 ) -> String {
+    format_grid(rows, cols, |r, c| {
+        let e = entries.get(&(r.to_string(), c.to_string()))?;
+        Some(format!("{:.2} s / {:.0} spp", e.seconds, e.spp))
+    })
+}
+
+/// Each entry's numerator over its denominator (two decimals), same layout.
+pub fn format_ratio_table(
+    rows: &[String],
+    cols: &[String],
+    entries: &BTreeMap<(String, String), (f64, f64)>,
+) -> String {
+    format_grid(rows, cols, |r, c| {
+        let &(num, den) = entries.get(&(r.to_string(), c.to_string()))?;
+        (den > 0.0).then(|| format!("{:.2}", num / den))
+    })
+}
+
+/// A scene × column table whose cells `cell(row, column)` writes ("–" where it has none).
+fn format_grid(
+    rows: &[String],
+    cols: &[String],
+    cell: impl Fn(&str, &str) -> Option<String>,
+) -> String {
     let mut s = String::from("| scene |");
     for c in cols {
         let _ = write!(s, " {c} |");
@@ -239,12 +263,7 @@ pub fn format_time_table(
     for r in rows {
         let _ = write!(s, "| {r} |");
         for c in cols {
-            match entries.get(&(r.clone(), c.clone())) {
-                Some(e) => {
-                    let _ = write!(s, " {:.2} s / {:.0} spp |", e.seconds, e.spp);
-                }
-                None => s.push_str(" – |"),
-            }
+            let _ = write!(s, " {} |", cell(r, c).as_deref().unwrap_or("–"));
         }
         s.push('\n');
     }
@@ -460,6 +479,9 @@ mod tests {
         let cols = vec!["a".to_string()];
         let m = BTreeMap::from([(("s".to_string(), "a".to_string()), e(0.1, 0.0, 1, 1.5))]);
         assert!(format_time_table(&rows, &cols, &m).contains("| s | 1.50 s / 16 spp |"));
+        let rays = BTreeMap::from([(("s".to_string(), "a".to_string()), (39.0, 10.0))]);
+        assert!(format_ratio_table(&rows, &cols, &rays).contains("| s | 3.90 |"));
+        assert!(format_ratio_table(&rows, &cols, &BTreeMap::new()).contains("| s | – |"));
     }
 }
 

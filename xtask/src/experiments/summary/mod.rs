@@ -56,6 +56,7 @@ pub fn generate(
     tables::write_error_tables(&mut md, &layout, &cells, Pixels::All);
     tables::write_flip_tables(&mut md, &layout, &cells, Pixels::All);
     tables::write_time_tables(&mut md, &layout, &cells);
+    tables::write_ray_table(&mut md, &layout, &cells);
     figures::write_figures(&mut md, &layout, &cells, out, refs_dir)?;
     write_notices(&mut md, notices);
     write_missing(&mut md, exp, &cells);

@@ -1,5 +1,5 @@
 //! table.md's tables: relMSE, HDR-ꟻLIP, multiples of the oracle, seconds and spp reached,
-//! one per budget.
+//! one per budget; shadow rays per camera sample, one for all budgets.
 use super::layout::{Layout, clock_words};
 use crate::experiments::cell::CellResult;
 use crate::experiments::config::BudgetClock;
@@ -144,4 +144,30 @@ pub fn write_time_tables(md: &mut String, layout: &Layout, cells: &[CellResult])
         md.push_str(&report::format_time_table(&layout.rows, &layout.cols, &g));
         md.push('\n');
     }
+}
+
+/// Shadow rays per camera sample of each scene × strategy, over all its cells (every budget):
+/// what a sample costs in visibility, beside the seconds and spp of the time tables.
+pub fn write_ray_table(md: &mut String, layout: &Layout, cells: &[CellResult]) {
+    let mut sums: BTreeMap<(String, String), (f64, f64)> = BTreeMap::new();
+    for c in cells {
+        let rays = &c.render["rays"];
+        if let (Some(shadow), Some(camera)) = (rays["shadow"].as_f64(), rays["camera"].as_f64()) {
+            let e = sums
+                .entry((c.scene.clone(), c.strategy.clone()))
+                .or_default();
+            e.0 += shadow;
+            e.1 += camera;
+        }
+    }
+    if sums.is_empty() {
+        return;
+    }
+    md.push_str("## Shadow rays per camera sample (all budgets)\n\n");
+    md.push_str(&report::format_ratio_table(
+        &layout.rows,
+        &layout.cols,
+        &sums,
+    ));
+    md.push('\n');
 }
