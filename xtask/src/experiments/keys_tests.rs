@@ -345,7 +345,8 @@ fn threads_strategy_parameters_and_code_rerender_exactly_their_cells() {
     assert!(d.rendered.is_empty(), "{:?}", d.rendered);
     assert_eq!(d.reused.len(), 12);
     assert_eq!(code_of("MIS").id, now.id);
-    // and a table of them is one code state: named, not refused, no row marked
+    // and a table of them is one code state: named by the commit that rendered them (the
+    // run's own rendered nothing), not refused, no row marked
     let perm = Permissions {
         allow_dirty: true,
         current: Some(now),
@@ -353,7 +354,8 @@ fn threads_strategy_parameters_and_code_rerender_exactly_their_cells() {
     };
     summary::generate(&b.exp, &b.out(), &b.base.join("refs"), &[], &perm).unwrap();
     let md = std::fs::read_to_string(b.out().join("table.md")).unwrap();
-    assert!(md.contains("with the same code"), "{md}");
+    assert!(md.contains("rendered by **commit fedcba987654**"), "{md}");
+    assert!(!md.contains("with the same code"), "{md}");
     assert!(!md.contains("rows marked ‡"), "{md}");
     let _ = std::fs::remove_dir_all(&b.base);
 }

@@ -122,12 +122,22 @@ impl Provenance {
         for c in cells {
             *states.entry(c.code_state()).or_default() += 1;
         }
-        let main = perm.current.clone().or_else(|| {
+        let most = |same: &dyn Fn(&CodeState) -> bool| {
             states
                 .iter()
+                .filter(|(s, _)| same(s))
                 .max_by(|a, b| a.1.cmp(b.1).then(b.0.cmp(a.0)))
                 .map(|(s, _)| s.clone())
-        });
+        };
+        // A run that rendered nothing (every cell reused from a commit with the same code) names
+        // the commit that rendered them, not its own.
+        let main = match &perm.current {
+            Some(cur) if !states.contains_key(cur) => {
+                Some(most(&|s: &CodeState| s.id == cur.id).unwrap_or_else(|| cur.clone()))
+            }
+            Some(cur) => Some(cur.clone()),
+            None => most(&|_: &CodeState| true),
+        };
         let dirty = states.keys().any(|s| s.dirty);
         if dirty && !perm.allow_dirty {
             let which: Vec<String> = states
