@@ -63,9 +63,9 @@ impl History {
             ..self.reservoirs[i]
         };
         if pairwise {
-            pairwise_resample(pass.scene, (r0, sp0), &[(r1, sp1)], rng, c)
+            pairwise_resample(pass.scene, (r0, sp0), std::iter::once((r1, sp1)), rng, c)
         } else {
-            biased_resample(pass.scene, (r0, sp0), &[r1], rng)
+            biased_resample(pass.scene, (r0, sp0), std::iter::once(r1), rng)
         }
     }
 }

@@ -103,32 +103,29 @@ pub fn pairwise_round(
     let Some(sp0) = &pass.points[i] else {
         return prev[i];
     };
-    let others: Vec<(Reservoir, &ShadingPoint)> = nbrs
-        .iter()
-        .map(|&j| {
-            let spj = pass.points[j].as_ref();
-            (prev[j], spj.expect("neighbours have shading points"))
-        })
-        .collect();
-    pairwise_resample(pass.scene, (prev[i], sp0), &others, rng, c)
+    let others = nbrs.iter().map(|&j| {
+        let spj = pass.points[j].as_ref();
+        (prev[j], spj.expect("neighbours have shading points"))
+    });
+    pairwise_resample(pass.scene, (prev[i], sp0), others, rng, c)
 }
 
 /// GRIS with pairwise MIS weights: the canonical reservoir `r0` of shading point `sp0` and
 /// the reservoirs `others` of other shading points (neighbours, or the pixel's own of the
 /// previous pass), each with its confidence, resampled into one reservoir for `sp0`.
-pub fn pairwise_resample(
+pub fn pairwise_resample<'a>(
     scene: &Scene,
     (r0, sp0): (Reservoir, &ShadingPoint),
-    others: &[(Reservoir, &ShadingPoint)],
+    others: impl Iterator<Item = (Reservoir, &'a ShadingPoint)> + Clone,
     rng: &mut SampleStream,
     c: &mut Counters,
 ) -> Reservoir {
-    if others.is_empty() {
+    let k = others.clone().count();
+    if k == 0 {
         return r0;
     }
-    let k = others.len() as f32;
-    let c0k = r0.c / k;
-    let total = r0.c + others.iter().map(|(r, _)| r.c).sum::<f32>();
+    let c0k = r0.c / k as f32;
+    let total = r0.c + others.clone().map(|(r, _)| r.c).sum::<f32>();
     // The pixel's own sample is visible from it whenever W > 0 (every phase keeps only such).
     let p0_y0 = if r0.w > 0.0 {
         target(scene, sp0, &r0.y).map_or(0.0, |t| t.0)
@@ -137,7 +134,7 @@ pub fn pairwise_resample(
     };
     let mut stream = Stream::default();
     let mut m0 = 0.0;
-    for &(rj, spj) in others {
+    for (rj, spj) in others {
         let pair = (rj.c + c0k) / total;
         if p0_y0 > 0.0 {
             let pj_y0 = seen_target(scene, spj, &r0, c);
@@ -173,8 +170,12 @@ pub fn biased_round(
     let Some(sp0) = &pass.points[i] else {
         return prev[i];
     };
-    let others: Vec<Reservoir> = nbrs.iter().map(|&j| prev[j]).collect();
-    biased_resample(pass.scene, (prev[i], sp0), &others, rng)
+    biased_resample(
+        pass.scene,
+        (prev[i], sp0),
+        nbrs.iter().map(|&j| prev[j]),
+        rng,
+    )
 }
 
 /// The paper's 1/M combination of the canonical reservoir `r0` of `sp0` and reservoirs
@@ -183,12 +184,12 @@ pub fn biased_round(
 pub fn biased_resample(
     scene: &Scene,
     (r0, sp0): (Reservoir, &ShadingPoint),
-    others: &[Reservoir],
+    others: impl Iterator<Item = Reservoir>,
     rng: &mut SampleStream,
 ) -> Reservoir {
     let mut stream = Stream::default();
     let mut total = 0.0;
-    for &r in std::iter::once(&r0).chain(others) {
+    for r in std::iter::once(r0).chain(others) {
         total += r.c;
         let u = rng.next_f32();
         if !(r.w > 0.0) {
