@@ -12,7 +12,7 @@ pub struct SampleStream {
     dim: u32,
     sampler: Sampler,
     /// Where the sample sits, for the samplers other than `independent`.
-    at: SamplePosition,
+    pub(crate) at: SamplePosition,
 }
 
 impl SampleStream {
@@ -72,16 +72,16 @@ impl SampleStream {
     /// A uniform number in [0, 1).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        // 24 high bits -> exactly representable, strictly below 1.
-        (self.next_u64() >> 40) as f32 * (1.0 / 16_777_216.0)
+        unit_f32(self.next_u64())
     }
 
     /// 64 uniform bits (one dimension), for draws that need more resolution than an f32's 24
     /// bits (e.g. a bin among many and a decision inside it).
     #[inline]
     pub fn next_u64(&mut self) -> u64 {
-        let bits = mix64(self.key ^ (self.dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        let bits = self.sampler.bits(&self.at, self.dim, bits);
+        let bits = self
+            .sampler
+            .bits(&self.at, self.dim, self.independent(self.dim));
         self.dim += 1;
         bits
     }
@@ -92,14 +92,28 @@ impl SampleStream {
         if self.sampler.pairs_dimensions() && self.dim % 2 == 1 {
             self.dim += 1;
         }
-        let a = self.next_f32();
-        glam::Vec2::new(a, self.next_f32())
+        let independent = [self.independent(self.dim), self.independent(self.dim + 1)];
+        let [a, b] = self.sampler.bits_2d(&self.at, self.dim, independent);
+        self.dim += 2;
+        glam::Vec2::new(unit_f32(a), unit_f32(b))
+    }
+
+    /// The independent hash of dimension `dim` of this sample.
+    #[inline]
+    fn independent(&self, dim: u32) -> u64 {
+        mix64(self.key ^ (dim as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15))
     }
 
     /// How many dimensions this sample has consumed.
     pub fn dimension(&self) -> u32 {
         self.dim
     }
+}
+
+/// A number in [0, 1) from the top 24 of 64 bits: exactly representable, strictly below 1.
+#[inline]
+fn unit_f32(bits: u64) -> f32 {
+    (bits >> 40) as f32 * (1.0 / 16_777_216.0)
 }
 
 #[cfg(test)]

@@ -98,9 +98,41 @@ impl Sampler {
             Sampler::LowDiscrepancy => xor_scrambled_sobol_value(at.pixel_key, at.index, dim),
             Sampler::ZSobol => crate::zsobol::zsobol_value(&at.z, dim),
         };
-        // The sequence's 32 bits on top, independent ones below them.
-        ((sequence as u64) << 32) | (independent & 0xffff_ffff)
+        with_independent(sequence, independent)
     }
+
+    /// The bits of dimensions `dim` and `dim + 1` ([`Sampler::bits`] of each), where a
+    /// sequence sampler computes what the pair shares (its hash and shuffled index) once.
+    /// `dim` must be even for the samplers that pair dimensions.
+    #[inline]
+    pub(crate) fn bits_2d(self, at: &SamplePosition, dim: u32, independent: [u64; 2]) -> [u64; 2] {
+        let [(raw0, s0), (raw1, s1)] = match self {
+            Sampler::Sobol | Sampler::LowDiscrepancy => {
+                shuffled_sobol_pair(at.pixel_key, at.index, dim)
+            }
+            _ => {
+                return [
+                    self.bits(at, dim, independent[0]),
+                    self.bits(at, dim + 1, independent[1]),
+                ];
+            }
+        };
+        let (a, b) = if self == Sampler::Sobol {
+            (owen_scramble(raw0, s0), owen_scramble(raw1, s1))
+        } else {
+            (raw0 ^ s0, raw1 ^ s1)
+        };
+        [
+            with_independent(a, independent[0]),
+            with_independent(b, independent[1]),
+        ]
+    }
+}
+
+/// A sequence's 32 bits on top, independent ones below them.
+#[inline]
+fn with_independent(sequence: u32, independent: u64) -> u64 {
+    ((sequence as u64) << 32) | (independent & 0xffff_ffff)
 }
 
 impl std::fmt::Display for Sampler {
@@ -122,11 +154,23 @@ pub(crate) struct SamplePosition {
     pub z: crate::zsobol::ZOrder,
 }
 
-/// The second Sobol dimension at a 32-bit index, as a 32-bit fraction (the 64-bit
-/// generator's top bits: the direction numbers only shift right).
+/// The second Sobol dimension at a 32-bit index, as a 32-bit fraction: the 64-bit
+/// generator (`zsobol::sobol_second_64`) on 32 bits, whose upper half it leaves zero (the
+/// direction numbers only shift right), so its last step and half its bit reversal drop out.
 #[inline]
 fn sobol_second(index: u32) -> u32 {
-    crate::zsobol::sobol_second_64(index as u64)
+    const KEEP: [u32; 5] = [
+        0x5555_5555,
+        0x3333_3333,
+        0x0f0f_0f0f,
+        0x00ff_00ff,
+        0x0000_ffff,
+    ];
+    let mut y = index;
+    for (b, keep) in KEEP.iter().enumerate() {
+        y ^= (y >> (1u32 << b)) & keep;
+    }
+    y.reverse_bits()
 }
 
 /// The hash of one dimension pair of one pixel, from which its shuffle and scrambles come.
@@ -139,13 +183,31 @@ fn pair_hash(pixel_key: u64, dim: u32) -> u64 {
 /// pair's hash.
 #[inline]
 fn shuffled_sobol(pixel_key: u64, index: u32, dim: u32) -> (u32, u32) {
-    let pair = pair_hash(pixel_key, dim);
-    let shuffled = owen_scramble(index, pair as u32);
+    let (pair, shuffled) = pair_and_index(pixel_key, index, dim);
     if dim % 2 == 0 {
         (shuffled.reverse_bits(), (pair >> 32) as u32)
     } else {
         (sobol_second(shuffled), crate::hash::mix64(pair) as u32)
     }
+}
+
+/// The hash of `dim`'s pair and the sample index it shuffles to.
+#[inline]
+fn pair_and_index(pixel_key: u64, index: u32, dim: u32) -> (u64, u32) {
+    let pair = pair_hash(pixel_key, dim);
+    (pair, owen_scramble(index, pair as u32))
+}
+
+/// [`shuffled_sobol`] of both dimensions of the pair that starts at the even `dim`, the
+/// pair's hash and shuffled index computed once.
+#[inline]
+fn shuffled_sobol_pair(pixel_key: u64, index: u32, dim: u32) -> [(u32, u32); 2] {
+    debug_assert!(dim % 2 == 0);
+    let (pair, shuffled) = pair_and_index(pixel_key, index, dim);
+    [
+        (shuffled.reverse_bits(), (pair >> 32) as u32),
+        (sobol_second(shuffled), crate::hash::mix64(pair) as u32),
+    ]
 }
 
 /// The `sobol` sampler's value (a 32-bit fraction) of sample `index` in dimension `dim`, for
@@ -213,6 +275,43 @@ fn stratified_value(at: &SamplePosition, dim: u32, independent: u64) -> u32 {
 mod tests {
     use super::*;
     use crate::rng::SampleStream;
+
+    #[test]
+    fn second_dimension_on_32_bits_is_the_64_bit_generator() {
+        let mut x = 0x1234_5678u32;
+        for k in 0..32 {
+            assert_eq!(sobol_second(1 << k), crate::zsobol::sobol_second_64(1 << k));
+        }
+        for _ in 0..100_000 {
+            x = crate::hash::mix64(x as u64) as u32;
+            assert_eq!(sobol_second(x), crate::zsobol::sobol_second_64(x as u64));
+        }
+        assert_eq!(
+            sobol_second(u32::MAX),
+            crate::zsobol::sobol_second_64(u32::MAX as u64)
+        );
+    }
+
+    /// A 2D draw's shared work changes nothing: `bits_2d` is `bits` of each dimension.
+    #[test]
+    fn a_pair_at_once_is_each_dimension_alone() {
+        for sampler in Sampler::ALL {
+            for k in 0..200u64 {
+                let mut at = SampleStream::with_sampler(sampler, 3, k * 7919, k % 37)
+                    .with_pixel_samples(64)
+                    .in_image(((k % 16) as u32, (k / 16) as u32), (16, 16))
+                    .at;
+                at.index = (k as u32).wrapping_mul(0x9e37_79b9) >> (k % 32);
+                let dim = 2 * (k as u32 % 9);
+                let ind = [crate::hash::mix64(k), crate::hash::mix64(!k)];
+                let alone = [
+                    sampler.bits(&at, dim, ind[0]),
+                    sampler.bits(&at, dim + 1, ind[1]),
+                ];
+                assert_eq!(sampler.bits_2d(&at, dim, ind), alone, "{sampler}, case {k}");
+            }
+        }
+    }
 
     #[test]
     fn names_round_trip() {
