@@ -70,10 +70,38 @@ impl Camera {
 
     /// World ray through film position `film` in [0,1]² (x right, y down) for an image of the given aspect.
     pub fn ray_direction(&self, film: Vec2, aspect: f32) -> Vec3 {
-        let tan = (0.5 * self.yfov).tan();
-        let right = self.right();
-        let sx = (2.0 * film.x - 1.0) * tan * aspect;
-        let sy = (1.0 - 2.0 * film.y) * tan;
-        (self.forward + right * sx + self.up * sy).normalize()
+        self.film_rays(aspect).direction(film)
+    }
+
+    /// What every camera ray of an image of the given aspect shares, computed once.
+    pub fn film_rays(&self, aspect: f32) -> FilmRays {
+        FilmRays {
+            forward: self.forward,
+            right: self.right(),
+            up: self.up,
+            tan: (0.5 * self.yfov).tan(),
+            aspect,
+        }
+    }
+}
+
+/// A camera's frame and field of view for one image: [`Camera::ray_direction`] without the
+/// tangent and the cross product per ray (the same operations, so the same directions).
+#[derive(Clone, Copy, Debug)]
+pub struct FilmRays {
+    forward: Vec3,
+    right: Vec3,
+    up: Vec3,
+    tan: f32,
+    aspect: f32,
+}
+
+impl FilmRays {
+    /// The unit direction through film position `film` in [0,1]² (x right, y down).
+    #[inline]
+    pub fn direction(&self, film: Vec2) -> Vec3 {
+        let sx = (2.0 * film.x - 1.0) * self.tan * self.aspect;
+        let sy = (1.0 - 2.0 * film.y) * self.tan;
+        (self.forward + self.right * sx + self.up * sy).normalize()
     }
 }

@@ -2,7 +2,7 @@
 //! distant lights there.
 use crate::accel::StreamRay;
 use crate::bsdf::Bsdf;
-use crate::camera::Camera;
+use crate::camera::{Camera, FilmRays};
 use crate::estimator::{DirectLighting, SampleContext, ShadingPoint};
 use crate::rng::SampleStream;
 use crate::scene::{NO_LIGHT, Scene, SurfaceHit};
@@ -47,16 +47,16 @@ pub(super) fn camera_hit(
     film: Vec2,
     counters: &mut Counters,
 ) -> (CameraSample, Option<ShadingPoint>) {
-    let ray = camera_ray(camera, aspect, film);
+    let ray = camera_ray(camera, &camera.film_rays(aspect), film);
     let hit = scene.intersect(ray.origin, ray.dir, ray.tmin, ray.tmax);
     seen_by_camera(scene, ray.dir, hit, counters)
 }
 
-/// The camera ray through `film` (in [0, 1]²).
-pub(super) fn camera_ray(camera: &Camera, aspect: f32, film: Vec2) -> StreamRay {
+/// The camera ray through `film` (in [0, 1]²), `lens` being `camera`'s for the image.
+pub(super) fn camera_ray(camera: &Camera, lens: &FilmRays, film: Vec2) -> StreamRay {
     StreamRay {
         origin: camera.position,
-        dir: camera.ray_direction(film, aspect),
+        dir: lens.direction(film),
         tmin: 0.0,
         tmax: f32::INFINITY,
     }

@@ -46,11 +46,12 @@ impl PassJob<'_> {
         let mut rngs = Vec::with_capacity(n);
         let mut films = Vec::with_capacity(n);
         let mut rays = Vec::with_capacity(n);
+        let lens = self.settings.camera.film_rays(self.aspect);
         for i in 0..n {
             let index = first + i;
             let mut rng = self.sample_stream(index, sample_index);
             let (on_film, film, weight) = self.film_position(index, &mut rng);
-            rays.push(camera_ray(&self.settings.camera, self.aspect, film));
+            rays.push(camera_ray(&self.settings.camera, &lens, film));
             films.push((on_film, weight));
             rngs.push(rng);
         }
