@@ -62,7 +62,8 @@ fn scalar_sphere(c: Vec3, radius: f32, o: Vec3, d: Vec3, tmin: f32, tmax: f32) -
     }
 }
 
-/// Closest hit by testing every primitive in order, keeping strictly nearer ones.
+/// Closest hit by testing every primitive in index order, keeping strictly nearer ones: the
+/// nearest, ties to the lowest index, which is the traversal's rule.
 fn brute_force(prims: &[Primitive], o: Vec3, d: Vec3, tmin: f32, tmax: f32) -> Option<Hit> {
     let d = d + Vec3::ZERO;
     let mut best = None;
@@ -189,17 +190,8 @@ fn avx2_and_sse2_agree_bit_for_bit_and_match_brute_force() {
             r.map(|h| h.t.to_bits()),
             "distance, ray {k}"
         );
-        if let (Some(a), Some(r)) = (a, r) {
-            // Another primitive only at exactly the same distance (a shared edge).
-            if a.prim != r.prim {
-                assert_eq!(a.t, r.t);
-            } else {
-                assert_eq!(
-                    (a.b1.to_bits(), a.b2.to_bits()),
-                    (r.b1.to_bits(), r.b2.to_bits())
-                );
-            }
-        }
+        // Ties (shared edges) included: the same primitive and barycentrics.
+        assert_eq!(bits(a), bits(r), "closest hit against brute force, ray {k}");
         let oa = fast.occluded(o, d, tmin, tmax);
         assert_eq!(oa, sse.occluded(o, d, tmin, tmax), "occlusion, ray {k}");
         assert_eq!(oa, r.is_some(), "occlusion against brute force, ray {k}");
@@ -256,5 +248,60 @@ fn non_finite_and_far_away_rays_end_without_a_loop() {
                 assert!(h.is_none());
             }
         }
+    }
+}
+
+/// Two triangles across a shared edge, hit exactly on it at the same distance: the lower
+/// index wins whichever is numbered first, on every path, single and streamed, so the hit
+/// does not depend on the order a traversal meets them. (A filler grid around them gives
+/// the tree several levels.)
+#[test]
+fn an_exact_tie_goes_to_the_lowest_index() {
+    let a = Primitive::Triangle {
+        v0: Vec3::new(0.0, 0.0, 0.0),
+        v1: Vec3::new(1.0, 0.0, 0.0),
+        v2: Vec3::new(0.0, 1.0, 0.0),
+    };
+    let b = Primitive::Triangle {
+        v0: Vec3::new(1.0, 0.0, 0.0),
+        v1: Vec3::new(1.0, 1.0, 0.0),
+        v2: Vec3::new(0.0, 1.0, 0.0),
+    };
+    let filler = (0..64).map(|k| {
+        let c = Vec3::new((k % 8) as f32 * 3.0 + 4.0, (k / 8) as f32 * 3.0, 0.0);
+        Primitive::Triangle {
+            v0: c,
+            v1: c + Vec3::X,
+            v2: c + Vec3::Y,
+        }
+    });
+    let (o, d) = (Vec3::new(0.5, 0.5, 1.0), Vec3::new(0.0, 0.0, -1.0));
+    let alone = |p: Primitive| Accel::build(&[p]).intersect(o, d, 0.0, f32::INFINITY);
+    let (ta, tb) = (alone(a).unwrap().t, alone(b).unwrap().t);
+    assert_eq!(ta.to_bits(), tb.to_bits(), "not a tie: the test needs one");
+    for (first, second) in [(a, b), (b, a)] {
+        let prims: Vec<Primitive> = [first, second].into_iter().chain(filler.clone()).collect();
+        let mut accel = Accel::build(&prims);
+        for simd in Simd::ALL.into_iter().filter(|s| s.available()) {
+            accel.set_simd(simd).unwrap();
+            let hit = accel.intersect(o, d, 0.0, f32::INFINITY).unwrap();
+            assert_eq!((hit.prim, hit.t), (0, ta), "{simd:?}");
+            let mut hits = vec![None; 3];
+            let ray = StreamRay {
+                origin: o,
+                dir: d,
+                tmin: 0.0,
+                tmax: f32::INFINITY,
+            };
+            accel.intersect_stream(&[ray; 3], &mut hits);
+            assert!(
+                hits.iter().all(|h| h.is_some_and(|h| h.prim == 0)),
+                "{simd:?}"
+            );
+        }
+        assert_eq!(
+            brute_force(&prims, o, d, 0.0, f32::INFINITY).unwrap().prim,
+            0
+        );
     }
 }

@@ -37,7 +37,9 @@ pub fn with_stack<R>(need: usize, f: impl FnOnce(&mut [MaybeUninit<Entry>]) -> R
     }
 }
 
-/// Nearest primitive with t in [tmin, tmax) (an exact tie keeps the one met first).
+/// Nearest primitive with t in [tmin, tmax); of several at exactly the same distance, the
+/// lowest primitive index ([`leaf_closest`]), so the answer does not depend on the order in
+/// which the traversal meets them.
 #[inline(always)]
 pub fn closest<N: NodeTest>(
     w: &Wide,
@@ -104,8 +106,18 @@ pub fn push_nearest_on_top(
     }
 }
 
-/// Tests the primitives of leaf `code`, lowering `tmax` and replacing `best` at each strictly
-/// nearer hit (triangle packets first, lanes in order).
+/// Whether a hit of primitive `id` at `t` replaces `best` (whose distance `tmax` is, once
+/// there is one): nearer, or as near with a lower index. Every primitive at the final
+/// distance is tested whatever the order of the visits (a box is entered no later than the
+/// hits inside it, and entries are dropped only when beyond `tmax`), so with this rule the
+/// closest hit is the same for any traversal order: the nearest, ties to the lowest index.
+#[inline(always)]
+fn replaces(t: f32, id: u32, tmax: f32, best: &Option<Hit>) -> bool {
+    t < tmax || (t == tmax && best.is_some_and(|b| id < b.prim))
+}
+
+/// Tests the primitives of leaf `code`, lowering `tmax` and replacing `best` at each hit that
+/// [`replaces`] it (triangle packets first, lanes in order).
 #[inline(always)]
 pub fn leaf_closest(w: &Wide, code: u32, lr: &LaneRay, tmax: &mut f32, best: &mut Option<Hit>) {
     let (first, tris, spheres) = leaf_parts(code);
@@ -119,7 +131,7 @@ pub fn leaf_closest(w: &Wide, code: u32, lr: &LaneRay, tmax: &mut f32, best: &mu
         while ok != 0 {
             let l = ok.trailing_zeros() as usize;
             ok &= ok - 1;
-            if t[l] < *tmax {
+            if replaces(t[l], p.ids[l], *tmax, best) {
                 *tmax = t[l];
                 *best = Some(Hit {
                     prim: p.ids[l],
@@ -137,7 +149,7 @@ pub fn leaf_closest(w: &Wide, code: u32, lr: &LaneRay, tmax: &mut f32, best: &mu
         while ok != 0 {
             let l = ok.trailing_zeros() as usize;
             ok &= ok - 1;
-            if t[l] < *tmax {
+            if replaces(t[l], p.ids[l], *tmax, best) {
                 *tmax = t[l];
                 *best = Some(Hit {
                     prim: p.ids[l],
