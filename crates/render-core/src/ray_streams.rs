@@ -1,7 +1,7 @@
 //! Rays in streams: a batch of shading points hands its rays to the accelerator together
 //! ([`crate::accel::Accel::intersect_stream`], [`crate::accel::Accel::occluded_stream`]), which
 //! may interleave their traversals; each answer is the one the single-ray call gives.
-use crate::accel::{Hit, StreamRay};
+use crate::accel::{Accel, Hit, StreamRay};
 use crate::scene::{Scene, SurfaceHit, ray_epsilon};
 use glam::Vec3;
 
@@ -24,9 +24,32 @@ impl Scene {
         hits: &mut Vec<Option<Hit>>,
         out: &mut Vec<Option<SurfaceHit>>,
     ) {
+        self.surfaces_along(rays, hits, out, Accel::intersect_stream);
+    }
+
+    /// [`Scene::intersect_stream`] for rays that travel together (a tile's camera rays):
+    /// eight consecutive rays share a traversal ([`Accel::intersect_packets`]).
+    pub fn intersect_packets(
+        &self,
+        rays: &[StreamRay],
+        hits: &mut Vec<Option<Hit>>,
+        out: &mut Vec<Option<SurfaceHit>>,
+    ) {
+        self.surfaces_along(rays, hits, out, Accel::intersect_packets);
+    }
+
+    /// The hits of `rays` by `trace`, then their surfaces.
+    #[inline]
+    fn surfaces_along(
+        &self,
+        rays: &[StreamRay],
+        hits: &mut Vec<Option<Hit>>,
+        out: &mut Vec<Option<SurfaceHit>>,
+        trace: fn(&Accel, &[StreamRay], &mut [Option<Hit>]),
+    ) {
         hits.clear();
         hits.resize(rays.len(), None);
-        self.accel.intersect_stream(rays, hits);
+        trace(&self.accel, rays, hits);
         // Every hit triangle's record starts loading before the first is read.
         for h in hits.iter().flatten() {
             if let Some(tri) = self.triangles.get(h.prim as usize) {

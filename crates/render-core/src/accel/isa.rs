@@ -9,7 +9,7 @@ macro_rules! compiled_for {
         pub mod $name {
             use super::super::collapse::Wide;
             use super::super::traverse::{self, Entry};
-            use super::super::{Hit, StreamRay, stream};
+            use super::super::{Hit, StreamRay, coherent, stream};
             use glam::Vec3;
             use std::mem::MaybeUninit;
 
@@ -45,6 +45,16 @@ macro_rules! compiled_for {
                 hits: &mut [Option<Hit>],
             ) {
                 stream::closest_stream::<$test>(w, need, stream::HOT_NODES, rays, hits)
+            }
+
+            #[target_feature(enable = $features)]
+            pub unsafe fn closest_packets(
+                w: &Wide,
+                need: usize,
+                rays: &[StreamRay],
+                hits: &mut [Option<Hit>],
+            ) {
+                coherent::closest_packets::<$test>(w, need, rays, hits)
             }
 
             #[target_feature(enable = $features)]

@@ -124,6 +124,25 @@ impl BoxRay {
 /// Children of `n` the ray enters before `tmax` (bits 0–7) and the entry distances.
 pub trait NodeTest {
     fn test(n: &Node8, r: &BoxRay, tmax: f32) -> (u32, [f32; 8]);
+
+    /// [`NodeTest::test`] for one ray of a packet: sets `bit` in `entered` for each child the
+    /// ray enters and lowers `near` to the ray's entry distance where that is nearer.
+    #[inline(always)]
+    fn test_into(
+        n: &Node8,
+        r: &BoxRay,
+        tmax: f32,
+        bit: u32,
+        (entered, near): (&mut [u32; 8], &mut [f32; 8]),
+    ) {
+        let (mask, tnear) = Self::test(n, r, tmax);
+        for k in 0..8 {
+            let hit = (mask >> k) & 1;
+            entered[k] |= bit * hit;
+            let t = if hit != 0 { tnear[k] } else { f32::INFINITY };
+            near[k] = if t < near[k] { t } else { near[k] };
+        }
+    }
 }
 
 /// Two 4-lane passes (SSE2 on x86-64).
@@ -162,11 +181,17 @@ impl NodeTest for Lanes4 {
 pub struct Avx2;
 
 #[cfg(target_arch = "x86_64")]
-impl NodeTest for Avx2 {
+impl Avx2 {
+    /// The eight children's entry and exit distances (t0, t1); a child is entered where
+    /// t0 ≤ t1.
     // Intrinsics written here, not in a `#[target_feature]` function (which LLVM would not
     // inline): this body is only inlined into the AVX2 traversals, which enable AVX2.
     #[inline(always)]
-    fn test(n: &Node8, r: &BoxRay, tmax: f32) -> (u32, [f32; 8]) {
+    fn slabs(
+        n: &Node8,
+        r: &BoxRay,
+        tmax: f32,
+    ) -> (std::arch::x86_64::__m256, std::arch::x86_64::__m256) {
         use std::arch::x86_64::*;
         // SAFETY: only instantiated inside functions compiled with AVX2 enabled, which run
         // after `is_x86_feature_detected!("avx2")`; each row is eight readable f32s.
@@ -197,10 +222,50 @@ impl NodeTest for Avx2 {
                 ),
                 _mm256_set1_ps(tmax),
             );
+            (t0, t1)
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl NodeTest for Avx2 {
+    #[inline(always)]
+    fn test(n: &Node8, r: &BoxRay, tmax: f32) -> (u32, [f32; 8]) {
+        use std::arch::x86_64::*;
+        let (t0, t1) = Avx2::slabs(n, r, tmax);
+        // SAFETY: as in `Avx2::slabs`.
+        unsafe {
             let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32;
             let mut tnear = [0.0f32; 8];
             _mm256_storeu_ps(tnear.as_mut_ptr(), t0);
             (mask, tnear)
+        }
+    }
+
+    /// The default's operations in lanes: the hit mask as lanes ands in `bit` and picks t0
+    /// or +∞, and `min_ps(t, near)` is `t < near ? t : near`.
+    #[inline(always)]
+    fn test_into(
+        n: &Node8,
+        r: &BoxRay,
+        tmax: f32,
+        bit: u32,
+        (entered, near): (&mut [u32; 8], &mut [f32; 8]),
+    ) {
+        use std::arch::x86_64::*;
+        let (t0, t1) = Avx2::slabs(n, r, tmax);
+        // SAFETY: as in `Avx2::slabs`; `entered` and `near` are eight lanes each.
+        unsafe {
+            let hit = _mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1);
+            let e = _mm256_loadu_si256(entered.as_ptr() as *const __m256i);
+            let add = _mm256_and_si256(_mm256_castps_si256(hit), _mm256_set1_epi32(bit as i32));
+            _mm256_storeu_si256(
+                entered.as_mut_ptr() as *mut __m256i,
+                _mm256_or_si256(e, add),
+            );
+            let t = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t0, hit);
+            let m = _mm256_min_ps(t, _mm256_loadu_ps(near.as_ptr()));
+            _mm256_storeu_ps(near.as_mut_ptr(), m);
         }
     }
 }

@@ -1,5 +1,5 @@
 //! One work unit of a pass through a strategy's batched form (`crate::batch`), in phases:
-//! every pixel's film position and camera ray, the camera rays traced as one stream, the
+//! every pixel's film position and camera ray, the camera rays traced in packets of eight, the
 //! shading points lit together by the strategy, then each sample's distant lights and extra
 //! emission rays and its accumulation, exactly as `unit.rs` does one pixel at a time.
 use super::accum::PixelAccum;
@@ -56,7 +56,8 @@ impl PassJob<'_> {
             rngs.push(rng);
         }
         let (mut hits, mut surfaces) = (Vec::new(), Vec::new());
-        self.scene.intersect_stream(&rays, &mut hits, &mut surfaces);
+        self.scene
+            .intersect_packets(&rays, &mut hits, &mut surfaces);
         let mut cameras = Vec::with_capacity(n);
         let mut points = Vec::with_capacity(n);
         for (ray, hit) in rays.iter().zip(surfaces) {
