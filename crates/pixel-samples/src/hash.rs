@@ -15,7 +15,7 @@ pub(crate) fn mix64(mut z: u64) -> u64 {
 /// input bits below it (additions carry upwards; products with even constants shift up), and
 /// the map is a bijection.
 #[inline]
-fn laine_karras(mut x: u32, seed: u32) -> u32 {
+pub(crate) fn laine_karras(mut x: u32, seed: u32) -> u32 {
     x = x.wrapping_add(seed);
     x ^= x.wrapping_mul(0x6c50_b47c);
     x ^= x.wrapping_mul(0xb82f_1e52);

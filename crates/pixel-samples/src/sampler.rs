@@ -183,19 +183,8 @@ fn pair_hash(pixel_key: u64, dim: u32) -> u64 {
 /// pair's hash.
 #[inline]
 fn shuffled_sobol(pixel_key: u64, index: u32, dim: u32) -> (u32, u32) {
-    let (pair, shuffled) = pair_and_index(pixel_key, index, dim);
-    if dim % 2 == 0 {
-        (shuffled.reverse_bits(), (pair >> 32) as u32)
-    } else {
-        (sobol_second(shuffled), crate::hash::mix64(pair) as u32)
-    }
-}
-
-/// The hash of `dim`'s pair and the sample index it shuffles to.
-#[inline]
-fn pair_and_index(pixel_key: u64, index: u32, dim: u32) -> (u64, u32) {
     let pair = pair_hash(pixel_key, dim);
-    (pair, owen_scramble(index, pair as u32))
+    coordinate(pair, first_dimension(index, pair), dim % 2 == 1)
 }
 
 /// [`shuffled_sobol`] of both dimensions of the pair that starts at the even `dim`, the
@@ -203,11 +192,33 @@ fn pair_and_index(pixel_key: u64, index: u32, dim: u32) -> (u64, u32) {
 #[inline]
 fn shuffled_sobol_pair(pixel_key: u64, index: u32, dim: u32) -> [(u32, u32); 2] {
     debug_assert!(dim % 2 == 0);
-    let (pair, shuffled) = pair_and_index(pixel_key, index, dim);
+    let pair = pair_hash(pixel_key, dim);
+    let first = first_dimension(index, pair);
     [
-        (shuffled.reverse_bits(), (pair >> 32) as u32),
-        (sobol_second(shuffled), crate::hash::mix64(pair) as u32),
+        coordinate(pair, first, false),
+        coordinate(pair, first, true),
     ]
+}
+
+/// The first Sobol dimension at the index shuffled by `pair` (an Owen scrambling of the
+/// index, whose closing bit reversal the first dimension's own reversal undoes).
+#[inline]
+fn first_dimension(index: u32, pair: u64) -> u32 {
+    crate::hash::laine_karras(index.reverse_bits(), pair as u32)
+}
+
+/// The pair's first or second (`odd`) coordinate and its scramble, from the first
+/// coordinate (the shuffled index reversed).
+#[inline]
+fn coordinate(pair: u64, first: u32, odd: bool) -> (u32, u32) {
+    if odd {
+        (
+            sobol_second(first.reverse_bits()),
+            crate::hash::mix64(pair) as u32,
+        )
+    } else {
+        (first, (pair >> 32) as u32)
+    }
 }
 
 /// The `sobol` sampler's value (a 32-bit fraction) of sample `index` in dimension `dim`, for
