@@ -3,7 +3,9 @@
 //! plane, seen by a pinhole camera), and incoherent secondary rays of `builtin:emissive-mesh`
 //! (from its camera rays' shading points: shadow rays to random points on random lights, and
 //! cosine-distributed BSDF rays traced for their closest hit). Each is timed one ray at a time
-//! and as streams of [`STREAM`] rays (`Accel::intersect_stream`, `Accel::occluded_stream`).
+//! and as streams of [`STREAM`] rays (`Accel::intersect_stream`, `Accel::occluded_stream`);
+//! the camera rays (and `builtin:emissive-mesh`'s) also in packets of eight
+//! (`Accel::intersect_packets`).
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec2, Vec3};
 use render_core::accel::{Hit, StreamRay};
@@ -21,6 +23,14 @@ const STREAM: usize = 256;
 fn stream_hits(scene: &Scene, rays: &[StreamRay], hits: &mut [Option<Hit>]) -> usize {
     for (r, h) in rays.chunks(STREAM).zip(hits.chunks_mut(STREAM)) {
         scene.accel.intersect_stream(r, h);
+    }
+    hits.iter().filter(|h| h.is_some()).count()
+}
+
+/// Closest hits found tracing `rays` in packets of eight, [`STREAM`] rays a call.
+fn packet_hits(scene: &Scene, rays: &[StreamRay], hits: &mut [Option<Hit>]) -> usize {
+    for (r, h) in rays.chunks(STREAM).zip(hits.chunks_mut(STREAM)) {
+        scene.accel.intersect_packets(r, h);
     }
     hits.iter().filter(|h| h.is_some()).count()
 }
@@ -170,6 +180,9 @@ fn bench_rays(c: &mut Criterion) {
     g.bench_function("closest_hit_stream", |b| {
         b.iter(|| stream_hits(&scene, &camera_rays, &mut out))
     });
+    g.bench_function("closest_hit_packets", |b| {
+        b.iter(|| packet_hits(&scene, &camera_rays, &mut out))
+    });
     let mut blocked = vec![false; shadow_rays.len()];
     g.throughput(Throughput::Elements(shadow_rays.len() as u64));
     g.bench_function("shadow_stream", |b| {
@@ -279,6 +292,46 @@ fn bench_incoherent(c: &mut Criterion) {
     g.throughput(Throughput::Elements(shadow.len() as u64));
     g.bench_function("shadow_stream", |b| {
         b.iter(|| stream_blocked(&scene, &shadow, &mut blocked))
+    });
+    g.finish();
+    bench_camera(c, &scene);
+}
+
+/// `builtin:emissive-mesh`'s camera rays through the centres of 256×256 pixels, row by row:
+/// one at a time, in streams and in packets.
+fn bench_camera(c: &mut Criterion, scene: &Scene) {
+    let cam = scene.camera(None).unwrap();
+    let lens = cam.film_rays(1.0);
+    let rays: Vec<StreamRay> = (0..256 * 256)
+        .map(|i| {
+            let film = Vec2::new(
+                ((i % 256) as f32 + 0.5) / 256.0,
+                ((i / 256) as f32 + 0.5) / 256.0,
+            );
+            segment(cam.position, lens.direction(film), f32::INFINITY)
+        })
+        .collect();
+    let mut g = c.benchmark_group("rays_emissive_mesh_camera");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(rays.len() as u64));
+    g.bench_function("closest_hit", |b| {
+        b.iter(|| {
+            rays.iter()
+                .filter(|r| {
+                    scene
+                        .accel
+                        .intersect(r.origin, r.dir, 0.0, r.tmax)
+                        .is_some()
+                })
+                .count()
+        })
+    });
+    let mut out = vec![None; rays.len()];
+    g.bench_function("closest_hit_stream", |b| {
+        b.iter(|| stream_hits(scene, &rays, &mut out))
+    });
+    g.bench_function("closest_hit_packets", |b| {
+        b.iter(|| packet_hits(scene, &rays, &mut out))
     });
     g.finish();
 }

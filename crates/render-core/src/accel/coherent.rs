@@ -14,7 +14,7 @@
 use super::collapse::Wide;
 use super::node::{BoxRay, LEAF, NodeTest};
 use super::packet::LaneRay;
-use super::traverse::leaf_closest;
+use super::traverse::{fetch, leaf_closest};
 use super::{Hit, StreamRay, positive_zeros};
 use glam::Vec3;
 use std::mem::MaybeUninit;
@@ -121,6 +121,11 @@ fn closest_packet<N: NodeTest>(
         sp -= 1;
         // SAFETY: entries below `sp` were written.
         let e = unsafe { stack[sp].assume_init() };
+        if sp > 0 {
+            // The next entry's memory starts loading while this one is tested.
+            // SAFETY: as above.
+            fetch(w, unsafe { stack[sp - 1].assume_init() }.code);
+        }
         let mut rays = r.bound_for(e.rays, e.t);
         if rays == 0 {
             continue;
