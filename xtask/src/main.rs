@@ -4,6 +4,7 @@ mod experiments;
 mod flip_cmd;
 mod fuzz;
 mod glossy_mask;
+mod yardstick;
 
 /// Counts allocations for `fuzz` (a case may not allocate more than its file can describe).
 #[global_allocator]
@@ -14,7 +15,7 @@ fn main() -> std::process::ExitCode {
     match args.first().map(String::as_str) {
         None | Some("help") | Some("--help") => {
             println!(
-                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] [--publish] …    render an experiment (default `quick`) into out/NAME/ (git-ignored; --publish: the committed results/NAME/; see xtask/README.md)\n  merge-results [--experiment NAME] [--publish] [SHARD_DIRS…]    merge shard results and regenerate the report\n  report --experiment NAME [--publish]    rebuild the report (table.md, plots, strips, index.html) from a local run's cell files\n  headline [--check] [--readme PATH]    write README.md's headline table (between its headline-table markers) from results/paper/cells.csv\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  flip IMAGE.exr REFERENCE.exr [--mask M.png]… [--map OUT.png] [--json]    HDR-ꟻLIP of a render against a reference (the harness's metric)\n  fuzz [--minutes N] [--seed S] [--case K]    fuzz the scene loaders (crates/scene-fuzz) for N minutes\n  glossy-mask SCENE W H OUT.png [--max-alpha A] [--subpixels N] [--footprint R] [--no-emitter-px]    mask of the pixels whose camera rays see GGX α < A (the authors' objects: --subpixels 16 --footprint 1 --no-emitter-px)"
+                "cargo xtask <command>\n\ncommands:\n  help    this text\n  fit-sptd | fit-ltc | validate-brdf-integrals    brdf-integrals tables and accuracy report\n  run-experiments [--experiment NAME] [--list] [--only PATTERN] [--shard i/n] [--publish] …    render an experiment (default `quick`) into out/NAME/ (git-ignored; --publish: the committed results/NAME/; see xtask/README.md)\n  merge-results [--experiment NAME] [--publish] [SHARD_DIRS…]    merge shard results and regenerate the report\n  report --experiment NAME [--publish]    rebuild the report (table.md, plots, strips, index.html) from a local run's cell files\n  headline [--check] [--readme PATH]    write README.md's headline table (between its headline-table markers) from results/paper/cells.csv\n  contact-sheet    one labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/\n  flip IMAGE.exr REFERENCE.exr [--mask M.png]… [--map OUT.png] [--json]    HDR-ꟻLIP of a render against a reference (the harness's metric)\n  fuzz [--minutes N] [--seed S] [--case K]    fuzz the scene loaders (crates/scene-fuzz) for N minutes\n  glossy-mask SCENE W H OUT.png [--max-alpha A] [--subpixels N] [--footprint R] [--no-emitter-px]    mask of the pixels whose camera rays see GGX α < A (the authors' objects: --subpixels 16 --footprint 1 --no-emitter-px)\n  yardstick [--strategy S]… [--rounds N] [--spp LO,HI] [--pin CPU] [--mitsuba-python PY] [--no-mitsuba] [--out CSV]    marginal CPU per camera sample, ours against Mitsuba 3 (llvm_ad_rgb), one thread, in one sitting"
             );
         }
         Some(cmd @ ("fit-sptd" | "fit-ltc" | "validate-brdf-integrals")) => {
@@ -40,6 +41,8 @@ fn main() -> std::process::ExitCode {
         Some("glossy-mask") => return glossy_mask::main(&args),
         Some("flip") => return flip_cmd::main(&args),
         Some("fuzz") => return fuzz::main(&args),
+        // issue 55: ours against Mitsuba 3 per camera sample
+        Some("yardstick") => return yardstick::main(&args),
         Some(other) => {
             eprintln!("error: unknown xtask command `{other}` (try `cargo xtask help`)");
             std::process::exit(2);
