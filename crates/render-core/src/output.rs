@@ -34,14 +34,23 @@ pub fn write_atomically(
     }
 }
 
-/// Linear RGB float32 EXR.
+/// Linear RGB float32 EXR, the same bytes for the same pixels: the exr crate's default
+/// encoding (RLE, 64×64 tiles) with its tiles in increasing order, which it then keeps
+/// although it compresses them in parallel (in its default "unspecified" order a tile went
+/// into the file when its compression finished, so the bytes changed from run to run).
 pub fn write_exr(path: &Path, width: u32, height: u32, pixels: &[Vec3]) -> Result<(), String> {
+    use exr::prelude::*;
+    let encoding = Encoding {
+        line_order: LineOrder::Increasing,
+        ..Encoding::FAST_LOSSLESS
+    };
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        let p = pixels[y * width as usize + x];
+        (p.x, p.y, p.z)
+    });
+    let image = Image::from_encoded_channels((width as usize, height as usize), encoding, channels);
     write_atomically(path, |tmp| {
-        exr::prelude::write_rgb_file(tmp, width as usize, height as usize, |x, y| {
-            let p = pixels[y * width as usize + x];
-            (p.x, p.y, p.z)
-        })
-        .map_err(|e| e.to_string())
+        image.write().to_file(tmp).map_err(|e| e.to_string())
     })
 }
 
@@ -124,4 +133,52 @@ pub fn read_mask_png(path: &Path, width: u32, height: u32) -> Result<Vec<bool>, 
         ));
     }
     Ok(img.pixels().map(|p| p.0[0] == 0).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An image of many tiles written several times: the same bytes each time, tiles in
+    /// increasing order, and the pixels read back.
+    #[test]
+    fn an_exr_is_the_same_bytes_for_the_same_pixels() {
+        let (w, h) = (520u32, 300u32);
+        let pixels: Vec<Vec3> = (0..w * h)
+            .map(|i| {
+                Vec3::new(
+                    (i % 97) as f32 * 0.37,
+                    (i % 13) as f32,
+                    (i / w) as f32 * 1e-3,
+                )
+            })
+            .collect();
+        let dir = std::env::temp_dir().join(format!("manylights-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let bytes: Vec<Vec<u8>> = (0..6)
+            .map(|k| {
+                let path = dir.join(format!("{k}.exr"));
+                write_exr(&path, w, h, &pixels).unwrap();
+                std::fs::read(&path).unwrap()
+            })
+            .collect();
+        let meta = exr::meta::MetaData::read_from_file(dir.join("0.exr"), false).unwrap();
+        assert_eq!(
+            meta.headers[0].line_order,
+            exr::meta::attribute::LineOrder::Increasing
+        );
+        let back = read_exr(&dir.join("0.exr")).unwrap();
+        std::fs::remove_dir_all(&dir).unwrap();
+        assert!(
+            bytes.iter().all(|b| *b == bytes[0]),
+            "the bytes differ between writes"
+        );
+        assert_eq!((back.0, back.1), (w, h));
+        assert!(
+            back.2
+                .iter()
+                .zip(&pixels)
+                .all(|(a, b)| a.to_array().map(f32::to_bits) == b.to_array().map(f32::to_bits))
+        );
+    }
 }
