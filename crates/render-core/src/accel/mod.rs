@@ -211,67 +211,64 @@ pub struct StreamRay {
     pub tmax: f32,
 }
 
+/// The batch traversal `$name` of `isa` on `$accel`'s path (its AVX-512 or AVX2 build), else
+/// `$portable`: `$rays` answered into `$out`, which is filled with `$empty` for a scene without
+/// primitives.
+macro_rules! batch_on_path {
+    ($accel:ident, ($rays:ident, $out:ident), $empty:expr, $name:ident, $portable:expr) => {{
+        assert_eq!($rays.len(), $out.len(), "one answer per ray");
+        let Some(w) = $accel.wide.as_ref() else {
+            $out.fill($empty);
+            return;
+        };
+        let need = $accel.stack_need;
+        match $accel.simd {
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: `simd` names only a path the CPU has (`build`, `set_simd`).
+            Simd::Avx512 => unsafe { isa::avx512::$name(w, need, $rays, $out) },
+            #[cfg(target_arch = "x86_64")]
+            // SAFETY: as above.
+            Simd::Avx2 => unsafe { isa::avx2::$name(w, need, $rays, $out) },
+            _ => $portable(w, need, $rays, $out),
+        }
+    }};
+}
+
 impl Accel {
     /// [`Accel::intersect`] of every ray of `rays`, into `hits` in the same order: the same
     /// hits bit for bit, whatever the stream's length. The rays' traversals are interleaved
     /// so that one ray's memory loads overlap the others' tests.
     pub fn intersect_stream(&self, rays: &[StreamRay], hits: &mut [Option<Hit>]) {
-        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        let Some(w) = self.wide.as_ref() else {
-            hits.fill(None);
-            return;
-        };
-        let need = self.stack_need;
-        match self.simd {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `intersect`.
-            Simd::Avx512 => unsafe { isa::avx512::closest_stream(w, need, rays, hits) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `intersect`.
-            Simd::Avx2 => unsafe { isa::avx2::closest_stream(w, need, rays, hits) },
-            _ => stream::closest_stream::<node::Lanes4>(w, need, stream::HOT_NODES, rays, hits),
-        }
+        batch_on_path!(self, (rays, hits), None, closest_stream, |w, need, r, h| {
+            stream::closest_stream::<node::Lanes4>(w, need, stream::HOT_NODES, r, h)
+        })
     }
 
     /// [`Accel::intersect`] of every ray of `rays`, into `hits` in the same order, for rays
     /// that travel together (a tile's camera rays): each run of eight consecutive rays shares
     /// one traversal (`coherent.rs`). The same hits bit for bit as one at a time.
     pub fn intersect_packets(&self, rays: &[StreamRay], hits: &mut [Option<Hit>]) {
-        assert_eq!(rays.len(), hits.len(), "one hit slot per ray");
-        let Some(w) = self.wide.as_ref() else {
-            hits.fill(None);
-            return;
-        };
-        let need = self.stack_need;
-        match self.simd {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `intersect`.
-            Simd::Avx512 => unsafe { isa::avx512::closest_packets(w, need, rays, hits) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `intersect`.
-            Simd::Avx2 => unsafe { isa::avx2::closest_packets(w, need, rays, hits) },
-            _ => coherent::closest_packets::<node::Lanes4>(w, need, rays, hits),
-        }
+        batch_on_path!(
+            self,
+            (rays, hits),
+            None,
+            closest_packets,
+            coherent::closest_packets::<node::Lanes4>
+        )
     }
 
     /// [`Accel::occluded`] of every ray of `rays`, into `blocked` in the same order, the
     /// traversals interleaved as in [`Accel::intersect_stream`].
     pub fn occluded_stream(&self, rays: &[StreamRay], blocked: &mut [bool]) {
-        assert_eq!(rays.len(), blocked.len(), "one answer per ray");
-        let Some(w) = self.wide.as_ref() else {
-            blocked.fill(false);
-            return;
-        };
-        let need = self.stack_need;
-        match self.simd {
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `intersect`.
-            Simd::Avx512 => unsafe { isa::avx512::occluded_stream(w, need, rays, blocked) },
-            #[cfg(target_arch = "x86_64")]
-            // SAFETY: as in `intersect`.
-            Simd::Avx2 => unsafe { isa::avx2::occluded_stream(w, need, rays, blocked) },
-            _ => stream::occluded_stream::<node::Lanes4>(w, need, stream::HOT_NODES, rays, blocked),
-        }
+        batch_on_path!(
+            self,
+            (rays, blocked),
+            false,
+            occluded_stream,
+            |w, need, r, b| {
+                stream::occluded_stream::<node::Lanes4>(w, need, stream::HOT_NODES, r, b)
+            }
+        )
     }
 }
 
