@@ -4,8 +4,8 @@
 //! (from its camera rays' shading points: shadow rays to random points on random lights, and
 //! cosine-distributed BSDF rays traced for their closest hit). Each is timed one ray at a time
 //! and as streams of [`STREAM`] rays (`Accel::intersect_stream`, `Accel::occluded_stream`);
-//! the camera rays (and `builtin:emissive-mesh`'s) also in packets of eight
-//! (`Accel::intersect_packets`).
+//! the camera rays (and `builtin:emissive-mesh`'s camera and BSDF rays) also in packets of
+//! eight (`Accel::intersect_packets`).
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Mat4, Vec2, Vec3};
 use render_core::accel::{Hit, StreamRay};
@@ -287,6 +287,9 @@ fn bench_incoherent(c: &mut Criterion) {
     g.throughput(Throughput::Elements(bsdf.len() as u64));
     g.bench_function("closest_hit_stream", |b| {
         b.iter(|| stream_hits(&scene, &bsdf, &mut out))
+    });
+    g.bench_function("closest_hit_packets", |b| {
+        b.iter(|| packet_hits(&scene, &bsdf, &mut out))
     });
     let mut blocked = vec![false; shadow.len()];
     g.throughput(Throughput::Elements(shadow.len() as u64));
