@@ -166,4 +166,6 @@ fn pbrt_sphere_and_disk_lights_over_lambertian_plane() {
             assert!(se < 0.05 * expected, "{name} {s}: too noisy to test ({se})");
         }
     }
+    // Left behind only when an assertion failed, to look at.
+    std::fs::remove_dir_all(&dir).unwrap();
 }

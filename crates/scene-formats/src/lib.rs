@@ -15,6 +15,8 @@ pub mod gltf_reader;
 pub mod gltf_writer;
 pub mod pbrt;
 #[cfg(test)]
+mod scratch;
+#[cfg(test)]
 mod test_notice;
 
 use render_core::SceneError;

@@ -1,6 +1,7 @@
 //! The glTF reader's tests: small files written here, and the shared scenes where present.
 use super::meshes::triangle_list;
 use super::*;
+use crate::scratch::Scratch;
 use glam::{Vec2, Vec3};
 use render_core::light::LightShape;
 use serde_json::{Value, json};
@@ -18,40 +19,14 @@ fn f32_bytes(v: &[f32]) -> Vec<u8> {
     v.iter().flat_map(|x| x.to_le_bytes()).collect()
 }
 
-/// A test's own directory under the system's temporary one, removed with everything in it
-/// when the test ends (passed or panicked).
-struct Scratch(PathBuf);
-
-impl Scratch {
-    fn new() -> Scratch {
-        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-        let name = format!("scene-formats-gltf-tests-{}-{k}", std::process::id());
-        let dir = std::env::temp_dir().join(name);
-        std::fs::create_dir_all(&dir).unwrap();
-        Scratch(dir)
+/// Writes `doc` as a .gltf whose buffer 0 holds `bin` as a base64 data URI, in `tmp`.
+fn write_gltf(tmp: &Scratch, name: &str, mut doc: Value, bin: &[u8]) -> PathBuf {
+    if !bin.is_empty() {
+        doc["buffers"] = json!([{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}", base64::encode(bin)) }]);
     }
-
-    /// A file name in the directory.
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-
-    /// Writes `doc` as a .gltf whose buffer 0 holds `bin` as a base64 data URI.
-    fn gltf(&self, name: &str, mut doc: Value, bin: &[u8]) -> PathBuf {
-        if !bin.is_empty() {
-            doc["buffers"] = json!([{ "byteLength": bin.len(), "uri": format!("data:application/octet-stream;base64,{}", base64::encode(bin)) }]);
-        }
-        let path = self.path(name);
-        std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
-        path
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
+    let path = tmp.path(name);
+    std::fs::write(&path, serde_json::to_vec_pretty(&doc).unwrap()).unwrap();
+    path
 }
 
 /// One triangle (0,0,0), (1,0,0), (0,1,0) with u16 indices, plus UVs: accessors 0
@@ -84,7 +59,7 @@ const TRI: [f32; 9] = [0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0];
 
 #[test]
 fn hierarchy_transforms_reach_world_space_and_modes_are_handled() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     let (mut doc, bin) = triangle_doc(TRI);
     doc["scenes"] = json!([{ "nodes": [0] }]);
     doc["nodes"] = json!([
@@ -100,7 +75,7 @@ fn hierarchy_transforms_reach_world_space_and_modes_are_handled() {
         { "attributes": { "POSITION": 0 } },
         { "attributes": { "POSITION": 0 }, "mode": 0 }
     ] }));
-    let path = tmp.gltf("hierarchy.gltf", doc, &bin);
+    let path = write_gltf(&tmp, "hierarchy.gltf", doc, &bin);
     let (scene, report) = load_gltf_with_report(&path, None).unwrap();
     assert_eq!(scene.triangles.len(), 2);
     assert_eq!((report.primitives, report.skipped_primitives), (2, 1));
@@ -147,7 +122,7 @@ fn strips_and_fans_become_triangle_lists() {
 
 #[test]
 fn punctual_lights_with_radius_become_sphere_lights() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     let (mut doc, bin) = triangle_doc(TRI);
     doc["extensionsUsed"] = json!(["KHR_lights_punctual"]);
     doc["extensions"] = json!({ "KHR_lights_punctual": { "lights": [
@@ -166,7 +141,7 @@ fn punctual_lights_with_radius_become_sphere_lights() {
         { "translation": [2, 3, 0], "rotation": [s, 0, 0, c], "extensions": { "KHR_lights_punctual": { "light": 2 } } },
         { "rotation": [s, 0, 0, c], "extensions": { "KHR_lights_punctual": { "light": 3 } } }
     ]);
-    let path = tmp.gltf("lights.gltf", doc, &bin);
+    let path = write_gltf(&tmp, "lights.gltf", doc, &bin);
     let scene = load_gltf(&path, None).unwrap();
     assert_eq!(
         (
@@ -201,7 +176,7 @@ fn punctual_lights_with_radius_become_sphere_lights() {
 
 #[test]
 fn emissive_materials_become_lights_and_textures_gate_them() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     // Two triangles over a 2×1 emissive texture: black on the left, white on the right.
     let mut png = Vec::new();
     image::RgbImage::from_raw(2, 1, vec![0, 0, 0, 255, 255, 255])
@@ -241,7 +216,7 @@ fn emissive_materials_become_lights_and_textures_gate_them() {
         { "attributes": { "POSITION": 0, "TEXCOORD_0": 2 }, "indices": 1, "material": 1 },
         { "attributes": { "POSITION": 0, "TEXCOORD_0": 3 }, "indices": 1, "material": 1 }
     ] }]);
-    let path = tmp.gltf("emissive.gltf", doc, &bin);
+    let path = write_gltf(&tmp, "emissive.gltf", doc, &bin);
     let scene = load_gltf(&path, None).unwrap();
     assert_eq!(scene.triangles.len(), 3);
     assert_eq!(scene.stats.triangle_lights, 2);
@@ -257,7 +232,7 @@ fn emissive_materials_become_lights_and_textures_gate_them() {
 
 #[test]
 fn cameras_are_read_with_their_names_and_selectable() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     let (mut doc, bin) = triangle_doc(TRI);
     doc["cameras"] = json!([
         { "name": "wide", "type": "perspective", "perspective": { "yfov": 1.0, "aspectRatio": 2.0, "znear": 0.01 } },
@@ -270,7 +245,7 @@ fn cameras_are_read_with_their_names_and_selectable() {
         { "camera": 0, "translation": [0, 0, 5] },
         { "name": "side view", "camera": 1, "translation": [5, 0, 0], "rotation": [0, s, 0, c] }
     ]);
-    let path = tmp.gltf("cameras.gltf", doc, &bin);
+    let path = write_gltf(&tmp, "cameras.gltf", doc, &bin);
     let scene = load_gltf(&path, None).unwrap();
     let cam = scene.camera(None).unwrap();
     assert_eq!(
@@ -295,7 +270,7 @@ fn cameras_are_read_with_their_names_and_selectable() {
 
 #[test]
 fn bad_input_gives_a_clear_error() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     let missing = tmp.path("does-not-exist.glb");
     let e = err(load_gltf(&missing, None));
     assert!(matches!(e, SceneError::Io { .. }), "{e}");
@@ -326,13 +301,16 @@ fn bad_input_gives_a_clear_error() {
     ));
 
     let (doc, bin) = triangle_doc([0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0, 0.0, 1.0, 0.0]);
-    let e = err(load_gltf(&tmp.gltf("nan.gltf", doc, &bin), None));
+    let e = err(load_gltf(&write_gltf(&tmp, "nan.gltf", doc, &bin), None));
     assert!(matches!(e, SceneError::NonFiniteVertex { .. }), "{e}");
 
     let (mut doc, bin) = triangle_doc(TRI);
     doc["materials"] = json!([{ "name": "bad", "emissiveFactor": [1.0, -1.0, 0.0] }]);
     doc["meshes"][0]["primitives"][0]["material"] = json!(0);
-    let e = err(load_gltf(&tmp.gltf("negative.gltf", doc, &bin), None));
+    let e = err(load_gltf(
+        &write_gltf(&tmp, "negative.gltf", doc, &bin),
+        None,
+    ));
     assert!(matches!(e, SceneError::BadEmission { .. }), "{e}");
     assert!(e.to_string().contains("bad"), "{e}");
 
@@ -340,7 +318,7 @@ fn bad_input_gives_a_clear_error() {
     doc["materials"] = json!([{ "emissiveFactor": [1.0, 1.0, 1.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": -2.0 } } }]);
     doc["meshes"][0]["primitives"][0]["material"] = json!(0);
     assert!(matches!(
-        load_gltf(&tmp.gltf("negative2.gltf", doc, &bin), None),
+        load_gltf(&write_gltf(&tmp, "negative2.gltf", doc, &bin), None),
         Err(SceneError::BadEmission { .. })
     ));
 
@@ -351,7 +329,7 @@ fn bad_input_gives_a_clear_error() {
         json!([{ "mesh": 0 }, { "extensions": { "KHR_lights_punctual": { "light": 0 } } }]);
     doc["scenes"] = json!([{ "nodes": [0, 1] }]);
     assert!(matches!(
-        load_gltf(&tmp.gltf("negative3.gltf", doc, &bin), None),
+        load_gltf(&write_gltf(&tmp, "negative3.gltf", doc, &bin), None),
         Err(SceneError::BadEmission { .. })
     ));
 
@@ -359,7 +337,10 @@ fn bad_input_gives_a_clear_error() {
     let (mut doc, bin) = triangle_doc(TRI);
     doc["materials"] = json!([{ "emissiveFactor": [1.0, 1.0, 1.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 1e39 } } }]);
     doc["meshes"][0]["primitives"][0]["material"] = json!(0);
-    let e = err(load_gltf(&tmp.gltf("infinite.gltf", doc, &bin), None));
+    let e = err(load_gltf(
+        &write_gltf(&tmp, "infinite.gltf", doc, &bin),
+        None,
+    ));
     assert!(matches!(e, SceneError::BadEmission { .. }), "{e}");
     for (i, extras) in [json!({ "radius": -0.5 }), json!({ "radius": "big" })]
         .into_iter()
@@ -371,7 +352,7 @@ fn bad_input_gives_a_clear_error() {
         doc["nodes"] = json!([{ "mesh": 0 }, { "extensions": { "KHR_lights_punctual": { "light": 0 } }, "extras": extras }]);
         doc["scenes"] = json!([{ "nodes": [0, 1] }]);
         let e = err(load_gltf(
-            &tmp.gltf(&format!("radius{i}.gltf"), doc, &bin),
+            &write_gltf(&tmp, &format!("radius{i}.gltf"), doc, &bin),
             None,
         ));
         assert!(matches!(e, SceneError::BadLight { .. }), "{e}");
@@ -381,13 +362,14 @@ fn bad_input_gives_a_clear_error() {
         json!([{ "type": "perspective", "perspective": { "yfov": 4.0, "znear": 0.01 } }]);
     doc["nodes"] = json!([{ "mesh": 0 }, { "camera": 0 }]);
     doc["scenes"] = json!([{ "nodes": [0, 1] }]);
-    let e = err(load_gltf(&tmp.gltf("camera.gltf", doc, &bin), None));
+    let e = err(load_gltf(&write_gltf(&tmp, "camera.gltf", doc, &bin), None));
     assert!(
         matches!(e, SceneError::Gltf { .. }) && e.to_string().contains("yfov"),
         "{e}"
     );
 
-    let empty = tmp.gltf(
+    let empty = write_gltf(
+        &tmp,
         "empty.gltf",
         json!({ "asset": { "version": "2.0" }, "scenes": [{ "nodes": [] }] }),
         &[],
@@ -402,7 +384,7 @@ fn bad_input_gives_a_clear_error() {
         "scenes": [{ "nodes": [0] }]
     });
     let e = err(load_gltf(
-        &tmp.gltf("lights-only.gltf", lights_only, &[]),
+        &write_gltf(&tmp, "lights-only.gltf", lights_only, &[]),
         None,
     ));
     assert!(e.to_string().contains("no triangles"), "{e}");
@@ -410,18 +392,24 @@ fn bad_input_gives_a_clear_error() {
     let (mut doc, bin) = triangle_doc(TRI);
     doc["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
     doc["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
-    let e = err(load_gltf(&tmp.gltf("draco.gltf", doc, &bin), None));
+    let e = err(load_gltf(&write_gltf(&tmp, "draco.gltf", doc, &bin), None));
     assert!(e.to_string().contains("KHR_draco_mesh_compression"), "{e}");
 
     // An index past the vertex array, and an accessor past its buffer.
     let (mut doc, mut bin) = triangle_doc(TRI);
     bin[36..38].copy_from_slice(&7u16.to_le_bytes());
     doc["accessors"][1]["max"] = json!([7]);
-    let e = err(load_gltf(&tmp.gltf("bad-index.gltf", doc, &bin), None));
+    let e = err(load_gltf(
+        &write_gltf(&tmp, "bad-index.gltf", doc, &bin),
+        None,
+    ));
     assert!(matches!(e, SceneError::Gltf { .. }), "{e}");
     let (mut doc, bin) = triangle_doc(TRI);
     doc["accessors"][0]["count"] = json!(300);
-    let e = err(load_gltf(&tmp.gltf("short-buffer.gltf", doc, &bin), None));
+    let e = err(load_gltf(
+        &write_gltf(&tmp, "short-buffer.gltf", doc, &bin),
+        None,
+    ));
     assert!(matches!(e, SceneError::Gltf { .. }), "{e}");
 
     // Every message is one line.
@@ -437,7 +425,7 @@ fn bad_input_gives_a_clear_error() {
 /// → a warning and the glTF material.
 #[test]
 fn extras_pbrt_materials_load_as_described() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     use render_core::bsdf::Specular;
     use render_core::material::Model;
     let (mut doc, bin) = triangle_doc(TRI);
@@ -457,7 +445,7 @@ fn extras_pbrt_materials_load_as_described() {
     let prim = |m: usize| json!({ "attributes": { "POSITION": 0 }, "indices": 1, "material": m });
     doc["materials"] = Value::Array(materials.to_vec());
     doc["meshes"] = json!([{ "primitives": (0..materials.len()).map(prim).collect::<Vec<_>>() }]);
-    let path = tmp.gltf("extras_pbrt.gltf", doc, &bin);
+    let path = write_gltf(&tmp, "extras_pbrt.gltf", doc, &bin);
     let (scene, report) = load_gltf_with_report(&path, None).unwrap();
     let m = |name: &str| scene.materials.iter().find(|m| m.name == name).unwrap();
     let params = |name: &str| m(name).params_at(Vec2::ZERO);
@@ -635,7 +623,7 @@ fn every_shared_scene_loads_with_its_triangle_count() {
 
 #[test]
 fn external_buffers_and_texture_transforms() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     let (mut doc, bin) = triangle_doc(TRI);
     let bin_path = tmp.path("external.bin");
     std::fs::write(&bin_path, &bin).unwrap();

@@ -7,7 +7,7 @@ use render_core::material::Model;
 /// with a warning; an ior of 1 is an error naming the material.
 #[test]
 fn transmission_loads_as_the_rough_dielectric() {
-    let tmp = Scratch::new();
+    let tmp = Scratch::new("gltf-tests");
     let (mut doc, bin) = triangle_doc([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]);
     let materials = [
         json!({ "name": "clear", "pbrMetallicRoughness": { "baseColorFactor": [0.9, 0.8, 0.7, 1], "metallicFactor": 0.0, "roughnessFactor": 0.5 },
@@ -24,7 +24,7 @@ fn transmission_loads_as_the_rough_dielectric() {
         "KHR_materials_ior",
         "KHR_materials_volume"
     ]);
-    let path = tmp.gltf("transmission.gltf", doc.clone(), &bin);
+    let path = write_gltf(&tmp, "transmission.gltf", doc.clone(), &bin);
     let (scene, report) = load_gltf_with_report(&path, None).unwrap();
     let m = |name: &str| scene.materials.iter().find(|m| m.name == name).unwrap();
     assert_eq!(
@@ -54,6 +54,6 @@ fn transmission_loads_as_the_rough_dielectric() {
     assert!(!warned("clear", "ignored"), "{:?}", report.warnings);
 
     doc["materials"][0]["extensions"]["KHR_materials_ior"]["ior"] = json!(1.0);
-    let e = err(load_gltf(&tmp.gltf("ior1.gltf", doc, &bin), None)).to_string();
+    let e = err(load_gltf(&write_gltf(&tmp, "ior1.gltf", doc, &bin), None)).to_string();
     assert!(e.contains("clear") && e.contains("ior"), "{e}");
 }

@@ -1,15 +1,14 @@
 //! The pbrt loader against small scenes written by the tests.
 use super::*;
+use crate::scratch::Scratch;
 use glam::{Vec2, Vec3};
 use render_core::bsdf::Specular;
 use render_core::light::LightShape;
 use render_core::material::Model;
 use std::path::PathBuf;
 
-fn dir(test: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("scene-formats-pbrt-{}-{test}", std::process::id()));
-    std::fs::create_dir_all(&d).unwrap();
-    d
+fn dir(test: &str) -> Scratch {
+    Scratch::new(&format!("pbrt-{test}"))
 }
 
 fn write(d: &Path, name: &str, text: &str) -> PathBuf {
@@ -125,7 +124,7 @@ Shape "curve" "point3 P" [ 0 0 0 1 1 1 2 2 2 3 3 3 ]
 WorldEnd
 "#;
 
-fn load_test_scene() -> (render_core::scene::Scene, PbrtReport, PathBuf) {
+fn load_test_scene() -> (render_core::scene::Scene, PbrtReport, PathBuf, Scratch) {
     let d = dir("every");
     write_plys(&d);
     write(
@@ -140,7 +139,7 @@ fn load_test_scene() -> (render_core::scene::Scene, PbrtReport, PathBuf) {
     );
     let path = write(&d, "scene.pbrt", SCENE);
     let (scene, report) = load_pbrt_with_report(&path, None).unwrap();
-    (scene, report, path)
+    (scene, report, path, d)
 }
 
 fn close(a: Vec3, b: Vec3) -> bool {
@@ -149,7 +148,7 @@ fn close(a: Vec3, b: Vec3) -> bool {
 
 #[test]
 fn every_directive_loads_to_the_expected_scene() {
-    let (scene, report, _) = load_test_scene();
+    let (scene, report, _, _tmp) = load_test_scene();
     let sphere_tris = shapes::sphere(0.5).indices.len() / 3;
     // 1 + 2 (bilinear) + 1 + 2 (plys) + 1 (camera space) + 64 (disk) + 1 (reversed)
     // + sphere + 2 (instances) + 1 + 1 (includes)
@@ -383,7 +382,7 @@ fn sampler_and_pixel_filter_become_hints() {
 /// The scene converted to glTF and loaded back: same triangles, lights and materials.
 #[test]
 fn convert_round_trips_through_gltf() {
-    let (scene, _, path) = load_test_scene();
+    let (scene, _, path, _tmp) = load_test_scene();
     let glb = path.with_extension("glb");
     crate::gltf_writer::write_glb(&scene, &glb).unwrap();
     let back = crate::gltf_reader::load_gltf(&glb, None).unwrap();
