@@ -375,18 +375,19 @@ fn add_lights(b: &mut SceneBuilder, l: &LightLayout) -> Result<(), SceneError> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scratch::Scratch;
 
-    fn write(name: &str, text: &str) -> std::path::PathBuf {
-        let dir = std::env::temp_dir().join(format!("manylights-comp-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let p = dir.join(name);
+    fn write(tmp: &Scratch, name: &str, text: &str) -> std::path::PathBuf {
+        let p = tmp.path(name);
         std::fs::write(&p, text).unwrap();
         p
     }
 
     #[test]
     fn layouts_carry_their_power() {
+        let tmp = Scratch::new("composition");
         let p = write(
+            &tmp,
             "studio.toml",
             r#"
             [ground]
@@ -425,13 +426,19 @@ mod tests {
 
     #[test]
     fn bad_files_name_the_problem() {
-        let p = write("bad.toml", "[[lights]]\nlayout = \"spiral\"\n");
+        let tmp = Scratch::new("composition");
+        let p = write(&tmp, "bad.toml", "[[lights]]\nlayout = \"spiral\"\n");
         let e = load_composition(&p).err().expect("must fail").to_string();
         assert!(e.contains("bad.toml") && e.contains("spiral"), "{e}");
-        let p = write("missing.toml", "[[gltf]]\npath = \"no-such-file.glb\"\n");
+        let p = write(
+            &tmp,
+            "missing.toml",
+            "[[gltf]]\npath = \"no-such-file.glb\"\n",
+        );
         let e = load_composition(&p).err().expect("must fail").to_string();
         assert!(e.contains("no-such-file.glb"), "{e}");
         let p = write(
+            &tmp,
             "zero.toml",
             "[[lights]]\nlayout = \"grid\"\nshape = \"sphere\"\ncount = 0\ncenter = [0.0,0.0,0.0]\nextent = [1.0,0.0,1.0]\nsize = 0.1\npower = 1.0\n",
         );
@@ -439,6 +446,7 @@ mod tests {
         assert!(e.contains("lights[0]"), "{e}");
         // a count beyond any machine is refused at once (scene-fuzz found it loading for minutes)
         let p = write(
+            &tmp,
             "huge.toml",
             "[[lights]]\nlayout = \"random\"\nshape = \"quad\"\ncount = 9223372036854775807\ncenter = [0.0,0.0,0.0]\nextent = [1.0,0.0,1.0]\nsize = 0.1\npower = 1.0\n",
         );
