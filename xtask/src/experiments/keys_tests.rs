@@ -130,6 +130,15 @@ struct Bench {
     ml: Manylights,
 }
 
+impl Drop for Bench {
+    /// The test's directories go with it, unless it failed (then they are there to look at).
+    fn drop(&mut self) {
+        if !std::thread::panicking() {
+            let _ = std::fs::remove_dir_all(&self.base);
+        }
+    }
+}
+
 impl Bench {
     fn new(name: &str) -> Bench {
         let base = std::env::temp_dir().join(format!("xtask-keys-{}-{name}", std::process::id()));
