@@ -7,10 +7,12 @@
 //! share is the stack work, the loop and the node's loads, which dominate a single ray's
 //! visit (docs/notes/rays.md, "Packets").
 //!
-//! A ray may visit nodes it would not visit alone (an entry's distance is the least over its
-//! rays, so it is dropped only when beyond every ray's `tmax`), never fewer, and the closest
-//! hit does not depend on the order of the visits (`traverse::leaf_closest`: the nearest,
-//! ties to the lowest index). So each ray's hit is [`super::Accel::intersect`]'s bit for bit.
+//! A ray visits its nodes in another order than alone, and may visit nodes it would skip (an
+//! entry's distance is the least over its rays, so it is dropped only when beyond every ray's
+//! `tmax`); the closest hit does not depend on the order of the visits
+//! (`traverse::leaf_closest`: the nearest, ties to the lowest index), so each ray's hit is
+//! [`super::Accel::intersect`]'s bit for bit, but for the rounding exception `leaf_closest`'s
+//! rule names: at such a tie the packet may pick the other primitive at the same distance.
 use super::collapse::Wide;
 use super::node::{BoxRay, LEAF, NodeTest};
 use super::packet::LaneRay;

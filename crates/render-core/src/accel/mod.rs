@@ -246,7 +246,8 @@ impl Accel {
 
     /// [`Accel::intersect`] of every ray of `rays`, into `hits` in the same order, for rays
     /// that travel together (a tile's camera rays): each run of eight consecutive rays shares
-    /// one traversal (`coherent.rs`). The same hits bit for bit as one at a time.
+    /// one traversal (`coherent.rs`). The same hits bit for bit as one at a time, but at a
+    /// tie whose box entry rounds beyond the hit (`traverse::leaf_closest`).
     pub fn intersect_packets(&self, rays: &[StreamRay], hits: &mut [Option<Hit>]) {
         batch_on_path!(
             self,

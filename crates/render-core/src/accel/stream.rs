@@ -6,8 +6,8 @@
 //! no hand-over.)
 //!
 //! Each ray visits its own entries in exactly the order the single-ray traversal does (the
-//! same node tests, the same leaf helpers of `traverse`), so its hit is the same bit for bit
-//! (which the tie rule of `traverse::leaf_closest` would make it in any order). Entries beyond the ray's current `tmax` are dropped when they come to the
+//! same node tests, the same leaf helpers of `traverse`), so its hit is the same bit for bit,
+//! ties included. Entries beyond the ray's current `tmax` are dropped when they come to the
 //! top instead of when popped: `tmax` only shrinks, so those would have been skipped anyway.
 use super::collapse::Wide;
 use super::node::{BoxRay, LEAF, NodeTest, leaf_parts, prefetch};

@@ -20,7 +20,7 @@ fn paths() -> Vec<Simd> {
 }
 
 /// Rays a stream must answer as the single-ray calls do without a normal traversal.
-fn odd_rays() -> Vec<StreamRay> {
+pub(super) fn odd_rays() -> Vec<StreamRay> {
     let ray = |origin, dir, tmin, tmax| StreamRay {
         origin,
         dir,

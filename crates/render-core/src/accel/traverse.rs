@@ -107,10 +107,12 @@ pub fn push_nearest_on_top(
 }
 
 /// Whether a hit of primitive `id` at `t` replaces `best` (whose distance `tmax` is, once
-/// there is one): nearer, or as near with a lower index. Every primitive at the final
-/// distance is tested whatever the order of the visits (a box is entered no later than the
-/// hits inside it, and entries are dropped only when beyond `tmax`), so with this rule the
-/// closest hit is the same for any traversal order: the nearest, ties to the lowest index.
+/// there is one): nearer, or as near with a lower index. Entries are dropped only when beyond
+/// `tmax`, and a box's entry distance is as a rule no later than the hits inside it, so every
+/// primitive at the final distance is tested whatever the order of the visits and the closest
+/// hit is the same for any order: the nearest, ties to the lowest index. The exception is a
+/// tie whose other primitive lies on its box's face where the entry distance rounds beyond the
+/// hit's (seen on a ray from 1e30 away): a traversal that met the tie first skips it.
 #[inline(always)]
 fn replaces(t: f32, id: u32, tmax: f32, best: &Option<Hit>) -> bool {
     t < tmax || (t == tmax && best.is_some_and(|b| id < b.prim))
