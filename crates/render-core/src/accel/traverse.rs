@@ -39,7 +39,7 @@ pub fn with_stack<R>(need: usize, f: impl FnOnce(&mut [MaybeUninit<Entry>]) -> R
 
 /// Nearest primitive with t in [tmin, tmax); of several at exactly the same distance, the
 /// lowest primitive index ([`leaf_closest`]), so the answer does not depend on the order in
-/// which the traversal meets them.
+/// which the traversal meets them (but for the rounding exception `replaces` names).
 #[inline(always)]
 pub fn closest<N: NodeTest>(
     w: &Wide,
