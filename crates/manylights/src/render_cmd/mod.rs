@@ -75,7 +75,8 @@ pub struct RenderArgs {
     /// How camera samples go through shading: `batched` (a work unit's samples in phases
     /// together, their rays traced as streams, for the strategies that have a batched form)
     /// or `per-sample` (one camera sample at a time, every ray alone); the JSON's
-    /// `engine_used` says which ran. The image does not depend on it.
+    /// `engine_used` says which ran. The image does not depend on it (bit for bit, but where
+    /// two primitives tie at a rounding edge: docs/notes/rays.md, "Ties").
     #[arg(long, value_enum, default_value = "batched")]
     pub engine: EngineArg,
     /// Also write the mask of pixels that see a light directly and the strategy's diagnostics.
