@@ -46,22 +46,24 @@ impl Rays {
     /// direction, as `Accel::intersect` asks) with the least of their `tmin`.
     #[inline(always)]
     fn new(rays: &[StreamRay]) -> (Rays, u32, f32) {
-        let (mut live, mut tmin) = (0u32, f32::INFINITY);
-        let mut tmax = [f32::NEG_INFINITY; PACKET];
-        let unit = |i: usize| {
+        let units: [Option<(&StreamRay, Vec3)>; PACKET] = std::array::from_fn(|i| {
             let r = rays.get(i)?;
             (r.origin.is_finite() && r.dir.is_finite()).then(|| (r, positive_zeros(r.dir)))
-        };
-        let boxes = std::array::from_fn(|i| match unit(i) {
-            Some((r, d)) => {
+        });
+        let (mut live, mut tmin) = (0u32, f32::INFINITY);
+        let mut tmax = [f32::NEG_INFINITY; PACKET];
+        for (i, u) in units.iter().enumerate() {
+            if let Some((r, _)) = u {
                 live |= 1 << i;
                 tmin = tmin.min(r.tmin);
                 tmax[i] = r.tmax;
-                BoxRay::new(r.origin, d, r.tmin)
             }
+        }
+        let boxes = units.map(|u| match u {
+            Some((r, d)) => BoxRay::new(r.origin, d, r.tmin),
             None => BoxRay::new(Vec3::ZERO, Vec3::ONE, 0.0),
         });
-        let lanes = std::array::from_fn(|i| match unit(i) {
+        let lanes = units.map(|u| match u {
             Some((r, d)) => LaneRay::new(r.origin, d, r.tmin),
             None => LaneRay::new(Vec3::ZERO, Vec3::ONE, 0.0),
         });
