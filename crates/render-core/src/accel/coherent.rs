@@ -16,7 +16,7 @@
 use super::collapse::Wide;
 use super::node::{BoxRay, LEAF, NodeTest};
 use super::packet::LaneRay;
-use super::traverse::{fetch, leaf_closest};
+use super::traverse::{fetch, insert_nearest_on_top, leaf_closest};
 use super::{Hit, StreamRay, positive_zeros};
 use glam::Vec3;
 use std::mem::MaybeUninit;
@@ -183,13 +183,6 @@ fn push_nearest_on_top(
             t: near[k],
             rays: entered[k],
         };
-        let mut j = *sp;
-        // SAFETY: entries below `sp` were written.
-        while j > base && unsafe { stack[j - 1].assume_init() }.t < x.t {
-            stack[j] = stack[j - 1];
-            j -= 1;
-        }
-        stack[j] = MaybeUninit::new(x);
-        *sp += 1;
+        insert_nearest_on_top(stack, (base, sp), x, |e| e.t);
     }
 }

@@ -95,14 +95,7 @@ pub fn push_nearest_on_top(
             code: node.child[i],
             t: tnear[i],
         };
-        let mut j = *sp;
-        // SAFETY: entries below `sp` were written.
-        while j > base && unsafe { stack[j - 1].assume_init() }.t < x.t {
-            stack[j] = stack[j - 1];
-            j -= 1;
-        }
-        stack[j] = MaybeUninit::new(x);
-        *sp += 1;
+        insert_nearest_on_top(stack, (base, sp), x, |e| e.t);
     }
 }
 
@@ -116,6 +109,26 @@ pub fn push_nearest_on_top(
 #[inline(always)]
 fn replaces(t: f32, id: u32, tmax: f32, best: &Option<Hit>) -> bool {
     t < tmax || (t == tmax && best.is_some_and(|b| id < b.prim))
+}
+
+/// Pushes `x`, moving it below the entries from `base` up that are nearer (by `t`), so that
+/// those entries stay in decreasing distance with the nearest on top (an insertion sort step).
+/// Entries below `*sp` must be written.
+#[inline(always)]
+pub fn insert_nearest_on_top<E: Copy>(
+    stack: &mut [MaybeUninit<E>],
+    (base, sp): (usize, &mut usize),
+    x: E,
+    t: impl Fn(&E) -> f32,
+) {
+    let mut j = *sp;
+    // SAFETY: entries below `sp` were written.
+    while j > base && t(&unsafe { stack[j - 1].assume_init() }) < t(&x) {
+        stack[j] = stack[j - 1];
+        j -= 1;
+    }
+    stack[j] = MaybeUninit::new(x);
+    *sp += 1;
 }
 
 /// Tests the primitives of leaf `code`, lowering `tmax` and replacing `best` at each hit that
