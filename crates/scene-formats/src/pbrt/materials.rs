@@ -4,8 +4,8 @@
 //! |---|---|
 //! | `matte` (v3), `diffuse` (v4): `Kd` / `reflectance` | pure Lambert (no BRDF-oriented sampling there) |
 //! | `plastic` (v3): `Kd`, `Ks`, `roughness`, `remaproughness` | pbrt-v3's plastic ([`render_core::bsdf::plastic`]) |
-//! | `coateddiffuse` (v4): `reflectance`, `roughness`, `remaproughness` | the glTF dielectric (Lambert + GGX, Schlick F0 = 0.04), with a warning |
-//! | `conductor` (v4), `metal` (v3): `reflectance`, or `eta` + `k`, `roughness` | the glTF metal, F0 = reflectance or the normal-incidence Fresnel of η + ik |
+//! | `coateddiffuse` (v4): `reflectance`, `roughness`, `remaproughness` | the glTF dielectric (Lambert + GGX, Schlick F0 = 0.04, α = √roughness as v4 remaps), with a warning |
+//! | `conductor` (v4), `metal` (v3): `reflectance`, or `eta` + `k`, `roughness`, `remaproughness` | the glTF metal, F0 = reflectance or the normal-incidence Fresnel of η + ik; α = √roughness (`conductor`, v4's remap) or pbrt-v3's polynomial (`metal`) |
 //! | `dielectric` (v4), `glass` (v3): `eta` (`index`), `roughness` or `uroughness`/`vroughness`, `remaproughness`; v3's `Kt` | the rough dielectric ([`render_core::bsdf::dielectric`]): ior = η, α = √roughness (v4's remap) or pbrt-v3's polynomial (`glass`), tint = `Kt` |
 //! | `thindielectric` (v4): `eta` | an opaque black dielectric coat (F0 = ((η−1)/(η+1))²), with a warning |
 //! | anything else | `matte` 0.5, with a warning |
@@ -116,10 +116,17 @@ pub fn texture(class: &str, p: &ParamList, ctx: &mut Context) -> Result<TextureV
     }
 }
 
-/// pbrt's roughness parameters: `roughness` (or the mean of `uroughness`/`vroughness`),
-/// remapped by pbrt's `RoughnessToAlpha` when `remaproughness` (default true).
-fn alpha(p: &ParamList, ctx: &mut Context, default: f32) -> Result<f32, String> {
+/// pbrt-v3's roughness parameters: `roughness` (or the mean of `uroughness`/`vroughness`),
+/// remapped by pbrt-v3's `RoughnessToAlpha` (a polynomial in ln r) when `remaproughness`
+/// (default true). For v3's materials (`metal`, `glass`) only.
+fn v3_alpha(p: &ParamList, ctx: &mut Context, default: f32) -> Result<f32, String> {
     alpha_remapped(p, ctx, default, plastic::roughness_to_alpha)
+}
+
+/// pbrt-v4's: the same parameters remapped by v4's `RoughnessToAlpha`, √r. For v4's
+/// materials (`conductor`, `coateddiffuse`, `dielectric`, `thindielectric`).
+fn v4_alpha(p: &ParamList, ctx: &mut Context, default: f32) -> Result<f32, String> {
+    alpha_remapped(p, ctx, default, v4_roughness_to_alpha)
 }
 
 /// pbrt-v4's `RoughnessToAlpha`: √roughness.
@@ -196,7 +203,7 @@ pub fn material(
         }
         "coateddiffuse" => {
             let kd = ctx.colour(p, "reflectance", Vec3::splat(0.5))?;
-            let a = alpha(p, ctx, 0.0)?;
+            let a = v4_alpha(p, ctx, 0.0)?;
             for k in ["thickness", "albedo", "g", "maxdepth", "nsamples", "eta"] {
                 p.touch(k);
             }
@@ -207,8 +214,12 @@ pub fn material(
             gltf_like(name, kd, 0.0, a, 1.0)
         }
         "conductor" | "metal" => {
-            let default_roughness = if kind == "metal" { 0.01 } else { 0.0 };
-            let a = alpha(p, ctx, default_roughness)?;
+            // `metal` is pbrt-v3's (default roughness 0.01, v3's remap), `conductor` v4's.
+            let a = if kind == "metal" {
+                v3_alpha(p, ctx, 0.01)?
+            } else {
+                v4_alpha(p, ctx, 0.0)?
+            };
             let f0 = if p.has("reflectance") {
                 ctx.colour(p, "reflectance", Vec3::ONE)?
             } else {
@@ -224,9 +235,9 @@ pub fn material(
             let eta = index_of_refraction(p, ctx)?;
             dielectric::check_ior(eta).map_err(|e| format!("{kind}: {e}"))?;
             let a = if kind == "glass" {
-                alpha(p, ctx, 0.0)?
+                v3_alpha(p, ctx, 0.0)?
             } else {
-                alpha_remapped(p, ctx, 0.0, v4_roughness_to_alpha)?
+                v4_alpha(p, ctx, 0.0)?
             };
             let tint = ctx.colour(p, "Kt", Vec3::ONE)?;
             if ctx.colour(p, "Kr", Vec3::ONE)? != Vec3::ONE {
@@ -238,7 +249,7 @@ pub fn material(
         }
         "thindielectric" => {
             let eta = index_of_refraction(p, ctx)?;
-            let a = alpha(p, ctx, 0.0)?;
+            let a = v4_alpha(p, ctx, 0.0)?;
             for k in ["Kr", "Kt"] {
                 p.touch(k);
             }

@@ -590,3 +590,43 @@ Shape "trianglemesh" "point3 P" [ 0 0 2  1 0 2  0 1 2 ]
     )]);
     assert!(e.contains("one.pbrt:2") && e.contains("ior"), "{e}");
 }
+
+/// pbrt-v4's `conductor` and `coateddiffuse` remap roughness as v4 does (α = √r), pbrt-v3's
+/// `metal` as v3 does (its polynomial in ln r); `remaproughness false` takes r as α. The
+/// glTF-style material keeps √α as its roughness.
+#[test]
+fn conductor_and_coateddiffuse_remap_roughness_as_v4_metal_as_v3() {
+    let d = dir("remap");
+    let text = r#"Camera "perspective"
+WorldBegin
+LightSource "point" "point3 from" [ 0 0 -2 ] "rgb I" [ 1 1 1 ]
+MakeNamedMaterial "cond" "string type" "conductor" "rgb reflectance" [ 1 1 1 ] "float roughness" 0.09
+MakeNamedMaterial "condraw" "string type" "conductor" "float roughness" 0.09 "bool remaproughness" false
+MakeNamedMaterial "coat" "string type" "coateddiffuse" "float roughness" 0.16
+MakeNamedMaterial "v3" "string type" "metal" "float roughness" 0.1
+NamedMaterial "cond"
+Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  0 1 0 ]
+NamedMaterial "condraw"
+Shape "trianglemesh" "point3 P" [ 0 0 1  1 0 1  0 1 1 ]
+NamedMaterial "coat"
+Shape "trianglemesh" "point3 P" [ 0 0 2  1 0 2  0 1 2 ]
+NamedMaterial "v3"
+Shape "trianglemesh" "point3 P" [ 0 0 3  1 0 3  0 1 3 ]
+"#;
+    let (scene, _) = load_pbrt_with_report(&write(&d, "remap.pbrt", text), None).unwrap();
+    let alpha = |name: &str| {
+        let m = scene.materials.iter().find(|m| m.name == name).unwrap();
+        assert_eq!(m.model, Model::MetallicRoughness, "{name}");
+        m.roughness * m.roughness
+    };
+    let close = |a: f32, b: f32| (a - b).abs() < 1e-6;
+    assert!(close(alpha("cond"), 0.3), "{}", alpha("cond"));
+    assert!(close(alpha("condraw"), 0.09), "{}", alpha("condraw"));
+    assert!(close(alpha("coat"), 0.4), "{}", alpha("coat"));
+    let v3 = render_core::bsdf::plastic::roughness_to_alpha(0.1);
+    assert!(
+        close(alpha("v3"), v3) && !close(v3, 0.1f32.sqrt()),
+        "{}",
+        alpha("v3")
+    );
+}
