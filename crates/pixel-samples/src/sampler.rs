@@ -110,6 +110,13 @@ impl Sampler {
             Sampler::Sobol | Sampler::LowDiscrepancy => {
                 shuffled_sobol_pair(at.pixel_key, at.index, dim)
             }
+            Sampler::ZSobol => {
+                let [a, b] = crate::zsobol::zsobol_pair(&at.z, dim);
+                return [
+                    with_independent(a, independent[0]),
+                    with_independent(b, independent[1]),
+                ];
+            }
             _ => {
                 return [
                     self.bits(at, dim, independent[0]),

@@ -135,16 +135,42 @@ pub(crate) fn sobol_second_64(index: u64) -> u32 {
     (y.reverse_bits() >> 32) as u32
 }
 
+/// The hash of the dimension pair (2k, 2k + 1) that holds `dim`, and the sample's index
+/// shuffled by it: what the pair's two dimensions share.
+#[inline]
+fn pair_index(z: &ZOrder, dim: u32) -> (u64, u64) {
+    let pair = mix64(z.seed_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xa076_1d64_78bd_642f));
+    (pair, shuffle_digits(z, pair))
+}
+
+/// Dimension 2k's value from its pair's hash and shuffled index.
+#[inline]
+fn even_value(pair: u64, index: u64) -> u32 {
+    owen_scramble((index.reverse_bits() >> 32) as u32, pair as u32)
+}
+
+/// Dimension 2k + 1's.
+#[inline]
+fn odd_value(pair: u64, index: u64) -> u32 {
+    owen_scramble(sobol_second_64(index), (pair >> 32) as u32)
+}
+
 /// The `zsobol` value (a 32-bit fraction) of dimension `dim` of the sample at `z`.
 pub(crate) fn zsobol_value(z: &ZOrder, dim: u32) -> u32 {
-    let pair = mix64(z.seed_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xa076_1d64_78bd_642f));
-    let index = shuffle_digits(z, pair);
-    let (raw, scramble) = if dim % 2 == 0 {
-        ((index.reverse_bits() >> 32) as u32, pair as u32)
+    let (pair, index) = pair_index(z, dim);
+    if dim % 2 == 0 {
+        even_value(pair, index)
     } else {
-        (sobol_second_64(index), (pair >> 32) as u32)
-    };
-    owen_scramble(raw, scramble)
+        odd_value(pair, index)
+    }
+}
+
+/// [`zsobol_value`] of dimensions `dim` and `dim + 1` (`dim` even), the pair's digit shuffle
+/// done once: the same two values.
+pub(crate) fn zsobol_pair(z: &ZOrder, dim: u32) -> [u32; 2] {
+    debug_assert!(dim % 2 == 0);
+    let (pair, index) = pair_index(z, dim);
+    [even_value(pair, index), odd_value(pair, index)]
 }
 
 #[cfg(test)]
@@ -179,6 +205,20 @@ mod tests {
         }
     }
     use super::*;
+
+    /// A pair drawn at once is its two dimensions drawn one by one.
+    #[test]
+    fn a_pair_is_its_two_dimensions() {
+        for (i, spp) in [(0u32, 1u32), (3, 4), (5, 8), (100, 256)] {
+            for (x, y) in [(0, 0), (13, 7), (255, 200)] {
+                let z = ZOrder::new(mix64(5), (x, y), (256, 256), spp, i);
+                for dim in (0..40).step_by(2) {
+                    let want = [zsobol_value(&z, dim), zsobol_value(&z, dim + 1)];
+                    assert_eq!(zsobol_pair(&z, dim), want, "dim {dim}");
+                }
+            }
+        }
+    }
 
     #[test]
     fn the_permutation_table_holds_all_24() {
