@@ -143,26 +143,27 @@ fn pair_index(z: &ZOrder, dim: u32) -> (u64, u64) {
     (pair, shuffle_digits(z, pair))
 }
 
-/// Dimension 2k's value from its pair's hash and shuffled index.
+/// Dimension 2k's Sobol fraction and scramble seed, from its pair's hash and shuffled index.
 #[inline]
-fn even_value(pair: u64, index: u64) -> u32 {
-    owen_scramble((index.reverse_bits() >> 32) as u32, pair as u32)
+fn even_raw(pair: u64, index: u64) -> (u32, u32) {
+    ((index.reverse_bits() >> 32) as u32, pair as u32)
 }
 
 /// Dimension 2k + 1's.
 #[inline]
-fn odd_value(pair: u64, index: u64) -> u32 {
-    owen_scramble(sobol_second_64(index), (pair >> 32) as u32)
+fn odd_raw(pair: u64, index: u64) -> (u32, u32) {
+    (sobol_second_64(index), (pair >> 32) as u32)
 }
 
 /// The `zsobol` value (a 32-bit fraction) of dimension `dim` of the sample at `z`.
 pub(crate) fn zsobol_value(z: &ZOrder, dim: u32) -> u32 {
     let (pair, index) = pair_index(z, dim);
-    if dim % 2 == 0 {
-        even_value(pair, index)
+    let (raw, scramble) = if dim % 2 == 0 {
+        even_raw(pair, index)
     } else {
-        odd_value(pair, index)
-    }
+        odd_raw(pair, index)
+    };
+    owen_scramble(raw, scramble)
 }
 
 /// [`zsobol_value`] of dimensions `dim` and `dim + 1` (`dim` even), the pair's digit shuffle
@@ -170,7 +171,8 @@ pub(crate) fn zsobol_value(z: &ZOrder, dim: u32) -> u32 {
 pub(crate) fn zsobol_pair(z: &ZOrder, dim: u32) -> [u32; 2] {
     debug_assert!(dim % 2 == 0);
     let (pair, index) = pair_index(z, dim);
-    [even_value(pair, index), odd_value(pair, index)]
+    let ((r0, s0), (r1, s1)) = (even_raw(pair, index), odd_raw(pair, index));
+    [owen_scramble(r0, s0), owen_scramble(r1, s1)]
 }
 
 #[cfg(test)]
