@@ -352,6 +352,23 @@ fn bad_input_fails_cleanly() {
             ],
             "nonexistent-dir",
         ),
+        // named for another format: refused, not an EXR (or a PNG) behind a misleading name
+        (
+            vec![
+                "render".into(),
+                SCENE.into(),
+                "--spp".into(),
+                "1".into(),
+                "--quiet".into(),
+                "--out".into(),
+                dir.join("x.png").to_str().unwrap().into(),
+            ],
+            "writes an openexr image",
+        ),
+        (
+            r(SCENE, &["--png", "preview.jpg"]),
+            "--png writes a png image",
+        ),
     ];
     for (args, expect) in cases {
         let args: Vec<&str> = args.iter().map(String::as_str).collect();

@@ -279,11 +279,35 @@ pub fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// That the output files can be written, before a long render.
+/// That the output files are named for what they hold and can be written, before a long
+/// render.
 fn check_outputs(args: &RenderArgs) -> anyhow::Result<()> {
+    let preview = " (for a PNG preview add --png NAME.png)";
+    check_extension(&args.out, ("--out", "an OpenEXR image", "exr"), preview)?;
     check_writable(&args.out)?;
     if let Some(p) = &args.png {
+        check_extension(p, ("--png", "a PNG image", "png"), "")?;
         check_writable(p)?;
+    }
+    Ok(())
+}
+
+/// Refuses an output whose name does not end in `.ext` (any case): `flag` writes `what`
+/// whatever the name says, and a viewer that trusts the name would fail on it.
+fn check_extension(
+    path: &Path,
+    (flag, what, ext): (&str, &str, &str),
+    hint: &str,
+) -> anyhow::Result<()> {
+    let ok = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case(ext));
+    if !ok {
+        bail!(
+            "{flag} {}: {flag} writes {what}, so its name must end in .{ext}{hint}",
+            path.display()
+        );
     }
     Ok(())
 }
