@@ -140,6 +140,8 @@ fn list_scenes() {
 }
 
 fn convert(spec: &str, out: &std::path::Path) -> anyhow::Result<()> {
+    // Binary glTF whatever the name: a .gltf name would send other tools to their JSON reader.
+    render_cmd::check_extension(out, ("convert", "binary glTF", "glb"), "")?;
     let scene = scene_formats::load_scene(spec, None)?;
     for w in &scene.stats.warnings {
         eprintln!("warning: {w}");

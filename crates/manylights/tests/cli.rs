@@ -689,6 +689,14 @@ fn pbrt_scenes_info_convert_render_and_errors() {
         text.contains("lamp.pbrt:12: LightSource \"infinite\" is not supported"),
         "{text}"
     );
+    let gltf = dir.join("lamp.gltf");
+    let o = manylights(&["convert", s, gltf.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("must end in .glb"),
+        "{err}"
+    );
+    assert!(!gltf.exists(), "a refused conversion writes nothing");
     let glb = dir.join("lamp.glb");
     let o = manylights(&["convert", s, glb.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));

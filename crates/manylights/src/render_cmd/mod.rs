@@ -294,7 +294,7 @@ fn check_outputs(args: &RenderArgs) -> anyhow::Result<()> {
 
 /// Refuses an output whose name does not end in `.ext` (any case): `flag` writes `what`
 /// whatever the name says, and a viewer that trusts the name would fail on it.
-fn check_extension(
+pub fn check_extension(
     path: &Path,
     (flag, what, ext): (&str, &str, &str),
     hint: &str,
