@@ -88,7 +88,9 @@ const PERMUTATIONS: [[u8; 4]; 24] = {
 /// The index shuffled digit by digit from the top: each base-4 digit permuted by one of the
 /// 24 permutations, chosen by a hash of the original digits above it and of the pair; an odd
 /// last bit flipped by a hash bit. A bijection that maps aligned blocks onto aligned blocks.
-fn shuffle_digits(z: &ZOrder, pair: u64) -> u64 {
+/// `at_shift[s]` is [`digit_key`]`(pair, s)`.
+#[inline]
+fn shuffle_digits(z: &ZOrder, at_shift: &[u64; 64]) -> u64 {
     let mut out = 0u64;
     let mut shift = z.bits;
     while shift > 0 {
@@ -99,7 +101,7 @@ fn shuffle_digits(z: &ZOrder, pair: u64) -> u64 {
         } else {
             z.index >> (shift + width)
         };
-        let h = mix64(above ^ mix64(pair ^ ((shift as u64) << 56)));
+        let h = mix64(above ^ at_shift[shift as usize]);
         let digit = (z.index >> shift) & ((1 << width) - 1);
         let permuted = if width == 2 {
             PERMUTATIONS[(h % 24) as usize][digit as usize] as u64
@@ -109,6 +111,53 @@ fn shuffle_digits(z: &ZOrder, pair: u64) -> u64 {
         out |= permuted << shift;
     }
     out
+}
+
+/// The hash the permutation of the digit at bit `shift` starts from, before the digits above
+/// it are mixed in: the same for every pixel and sample of the image.
+fn digit_key(pair: u64, shift: u32) -> u64 {
+    mix64(pair ^ ((shift as u64) << 56))
+}
+
+/// What every sample of a render shares for one dimension pair: the pair's hash and its
+/// digit keys, for the seed's hash `seed_key` and pair number `number` (dims 2k, 2k + 1 are
+/// pair k + 1).
+#[derive(Clone, Copy)]
+struct PairKeys {
+    seed_key: u64,
+    number: u64,
+    pair: u64,
+    at_shift: [u64; 64],
+}
+
+impl PairKeys {
+    /// Matches no pair (numbers are below 2³²).
+    const NONE: PairKeys = PairKeys {
+        seed_key: 0,
+        number: u64::MAX,
+        pair: 0,
+        at_shift: [0; 64],
+    };
+
+    fn new(seed_key: u64, number: u64) -> PairKeys {
+        let pair = mix64(seed_key ^ number.wrapping_mul(0xa076_1d64_78bd_642f));
+        PairKeys {
+            seed_key,
+            number,
+            pair,
+            at_shift: std::array::from_fn(|s| digit_key(pair, s as u32)),
+        }
+    }
+}
+
+/// Pairs whose keys a thread keeps: a sample's first 32 dimensions never evict each other.
+const KEPT_PAIRS: usize = 16;
+
+thread_local! {
+    /// Each thread's keys of the pairs it drew last, by pair number modulo [`KEPT_PAIRS`]: a
+    /// memo of a pure function, so the values do not depend on which thread draws them.
+    static KEPT: std::cell::RefCell<[PairKeys; KEPT_PAIRS]> =
+        const { std::cell::RefCell::new([PairKeys::NONE; KEPT_PAIRS]) };
 }
 
 /// The second Sobol dimension at a 64-bit index, as a 32-bit fraction.
@@ -136,11 +185,19 @@ pub(crate) fn sobol_second_64(index: u64) -> u32 {
 }
 
 /// The hash of the dimension pair (2k, 2k + 1) that holds `dim`, and the sample's index
-/// shuffled by it: what the pair's two dimensions share.
+/// shuffled by it: what the pair's two dimensions share. The pair's keys come from the
+/// thread's memo, computed on a miss.
 #[inline]
 fn pair_index(z: &ZOrder, dim: u32) -> (u64, u64) {
-    let pair = mix64(z.seed_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xa076_1d64_78bd_642f));
-    (pair, shuffle_digits(z, pair))
+    let number = dim as u64 / 2 + 1;
+    KEPT.with(|kept| {
+        let mut kept = kept.borrow_mut();
+        let keys = &mut kept[number as usize % KEPT_PAIRS];
+        if keys.number != number || keys.seed_key != z.seed_key {
+            *keys = PairKeys::new(z.seed_key, number);
+        }
+        (keys.pair, shuffle_digits(z, &keys.at_shift))
+    })
 }
 
 /// Dimension 2k's Sobol fraction and scramble seed, from its pair's hash and shuffled index.
@@ -230,18 +287,61 @@ mod tests {
         assert_eq!(seen.len(), 24);
     }
 
+    /// The shuffle as first written: both hashes of a digit computed where they are used.
+    fn shuffle_unkept(z: &ZOrder, pair: u64) -> u64 {
+        let mut out = 0u64;
+        let mut shift = z.bits;
+        while shift > 0 {
+            let width = if shift == 1 { 1 } else { 2 };
+            shift -= width;
+            let above = if shift + width >= 64 {
+                0
+            } else {
+                z.index >> (shift + width)
+            };
+            let h = mix64(above ^ mix64(pair ^ ((shift as u64) << 56)));
+            let digit = (z.index >> shift) & ((1 << width) - 1);
+            let permuted = if width == 2 {
+                PERMUTATIONS[(h % 24) as usize][digit as usize] as u64
+            } else {
+                digit ^ (h & 1)
+            };
+            out |= permuted << shift;
+        }
+        out
+    }
+
+    /// The kept keys give the values computed from scratch, whatever the seeds and pairs drawn
+    /// before (seeds alternate here, pairs past the kept ones evict and refill).
+    #[test]
+    fn kept_keys_give_the_unkept_values() {
+        for k in 0..3000u64 {
+            let seed_key = mix64(k % 3);
+            let (x, y) = ((k * 7 % 200) as u32, (k * 13 % 150) as u32);
+            let z = ZOrder::new(seed_key, (x, y), (200, 150), 64, (k % 64) as u32);
+            let dim = (k * 5 % 80) as u32;
+            let pair = mix64(seed_key ^ (dim as u64 / 2 + 1).wrapping_mul(0xa076_1d64_78bd_642f));
+            assert_eq!(
+                pair_index(&z, dim),
+                (pair, shuffle_unkept(&z, pair)),
+                "case {k}"
+            );
+        }
+    }
+
     #[test]
     fn the_digit_shuffle_is_a_bijection() {
         for bits in [5u32, 6, 9] {
             let mut out: Vec<u64> = (0..1u64 << bits)
                 .map(|i| {
+                    let keys = PairKeys::new(3, 77);
                     shuffle_digits(
                         &ZOrder {
                             index: i,
                             bits,
                             seed_key: 3,
                         },
-                        77,
+                        &keys.at_shift,
                     )
                 })
                 .collect();
