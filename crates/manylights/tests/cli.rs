@@ -352,6 +352,25 @@ fn bad_input_fails_cleanly() {
             ],
             "nonexistent-dir",
         ),
+        // a zsobol index past 64 bits: refused, not a panic (nor, before, wrapped shifts)
+        (
+            vec![
+                "render".into(),
+                SCENE.into(),
+                "--sampler".into(),
+                "zsobol".into(),
+                "--spp".into(),
+                "4000000000".into(),
+                "--width".into(),
+                "1000000".into(),
+                "--height".into(),
+                "1".into(),
+                "--quiet".into(),
+                "--out".into(),
+                out.into(),
+            ],
+            "needs 72 bits",
+        ),
         // named for another format: refused, not an EXR (or a PNG) behind a misleading name
         (
             vec![

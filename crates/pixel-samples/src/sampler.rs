@@ -81,6 +81,20 @@ impl Sampler {
         matches!(self, Sampler::Stratified | Sampler::ZSobol)
     }
 
+    /// Refuses an image (its sample grid, splat border included) and a sample count the
+    /// sampler cannot number: `zsobol` numbers all of a render's samples with one 64-bit index.
+    pub fn check_image(self, (width, height): (u32, u32), spp: u32) -> Result<(), String> {
+        let bits = crate::zsobol::index_bits((width, height), spp);
+        if self == Sampler::ZSobol && bits > 64 {
+            return Err(format!(
+                "the zsobol sampler numbers a render's samples with one 64-bit index; a \
+                 {width}×{height} sample grid at {spp} spp needs {bits} bits: lower the spp or \
+                 the resolution, or choose another sampler"
+            ));
+        }
+        Ok(())
+    }
+
     /// Whether a 2D draw must start on an even dimension (a pair of the sequence).
     #[inline]
     pub(crate) fn pairs_dimensions(self) -> bool {
@@ -361,6 +375,23 @@ mod tests {
                 assert_eq!(sampler.bits_2d(&at, dim, ind), alone, "{sampler}, case {k}");
             }
         }
+    }
+
+    /// `zsobol` refuses a grid and spp whose sample index would pass 64 bits (2·11 + 32 = 54
+    /// fits, 2·20 + 32 = 72 does not); the other samplers take any.
+    #[test]
+    fn zsobol_refuses_an_index_past_64_bits() {
+        let huge = ((1u32 << 20, 1), u32::MAX);
+        for s in Sampler::ALL {
+            assert!(s.check_image((2048, 2048), u32::MAX).is_ok(), "{s}");
+            assert_eq!(
+                s.check_image(huge.0, huge.1).is_err(),
+                s == Sampler::ZSobol,
+                "{s}"
+            );
+        }
+        let e = Sampler::ZSobol.check_image(huge.0, huge.1).unwrap_err();
+        assert!(e.contains("72 bits"), "{e}");
     }
 
     #[test]

@@ -33,15 +33,22 @@ impl ZOrder {
         spp: u32,
         sample: u32,
     ) -> ZOrder {
-        let log2_res = ceil_log2(width.max(height));
+        let bits = index_bits((width, height), spp);
+        debug_assert!(bits <= 64, "Sampler::check_image refuses this size");
         let log2_spp = ceil_log2(spp.max(1));
         let index = (morton(x, y) << log2_spp) | (sample as u64 & ((1u64 << log2_spp) - 1));
         ZOrder {
             index,
-            bits: 2 * log2_res + log2_spp,
+            bits,
             seed_key,
         }
     }
+}
+
+/// Bits of the index that numbers every sample of a `width` × `height` image taking `spp`
+/// samples: 2·⌈log2 max(width, height)⌉ + ⌈log2 spp⌉. At most 64 fit.
+pub(crate) fn index_bits((width, height): (u32, u32), spp: u32) -> u32 {
+    2 * ceil_log2(width.max(height)) + ceil_log2(spp.max(1))
 }
 
 fn ceil_log2(n: u32) -> u32 {

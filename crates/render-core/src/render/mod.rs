@@ -94,6 +94,10 @@ pub fn render_cancellable(
         n_aux: strategy.aux_channels().len().min(MAX_AUX),
         grid: SampleGrid::new(w, h, settings.reconstruction, &settings.filter),
     };
+    if let Some(spp) = settings.spp {
+        let grid = (job.grid.width as u32, job.grid.height as u32);
+        settings.sampler.check_image(grid, spp)?;
+    }
     let mut passes = Passes::new(&job);
     let threads = pool.current_num_threads();
     let start = Instant::now();
