@@ -30,6 +30,7 @@ mod ray_streams;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+mod scene_builder;
 pub mod scene_hash;
 pub mod scene_hints;
 pub mod shading_point;
