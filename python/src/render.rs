@@ -21,6 +21,9 @@ pub struct Scene {
     spec: String,
     #[pyo3(get)]
     camera: Option<String>,
+    /// The scene's content hash, computed once at load for every render's JSON (hashing a
+    /// large scene takes longer than a small render).
+    hash: String,
 }
 
 #[pymethods]
@@ -61,14 +64,21 @@ pub fn load_scene(
         Some(name) => render_core::light_points::LightPoints::parse(&name).map_err(value_error)?,
         None => Default::default(),
     };
-    let mut scene = py
-        .detach(|| scene_formats::load_scene(&spec, camera.as_deref()))
-        .map_err(|e| value_error(format!("{:#}", anyhow::Error::from(e))))?;
+    let (mut scene, hash) = py
+        .detach(|| {
+            let scene = scene_formats::load_scene(&spec, camera.as_deref())?;
+            let hash = scene.content_hash();
+            Ok((scene, hash))
+        })
+        .map_err(|e: render_core::error::SceneError| {
+            value_error(format!("{:#}", anyhow::Error::from(e)))
+        })?;
     scene.light_points = points;
     Ok(Scene {
         inner: Arc::new(scene),
         spec,
         camera,
+        hash,
     })
 }
 
@@ -107,7 +117,7 @@ pub fn render<'py>(
     render_cmd::check_args(&args).map_err(cli_error)?;
     let prepared = render_cmd::prepare(&args, &scene.inner).map_err(cli_error)?;
     let result = run_interruptible(py, &scene.inner, &prepared, progress)?;
-    let meta = prepared.metadata(&args, &scene.inner, &result);
+    let meta = prepared.metadata(&args, (&scene.inner, &scene.hash), &result);
     let out = PyDict::new(py);
     out.set_item("width", result.width)?;
     out.set_item("height", result.height)?;

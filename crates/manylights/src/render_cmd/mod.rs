@@ -467,18 +467,20 @@ pub fn prepare(args: &RenderArgs, scene: &Scene) -> anyhow::Result<Prepared> {
 }
 
 impl Prepared {
-    /// The render's JSON record, as `render` writes it when it writes no file besides the EXR.
+    /// The render's JSON record, as `render` writes it when it writes no file besides the EXR;
+    /// `scene_hash` is `scene`'s [`Scene::content_hash`], which a caller rendering one scene
+    /// many times computes once.
     pub fn metadata(
         &self,
         args: &RenderArgs,
-        scene: &Scene,
+        (scene, scene_hash): (&Scene, &str),
         result: &RenderResult,
     ) -> serde_json::Value {
         let written = report::Written::nothing();
         let p = self;
         report::metadata(
             args,
-            scene,
+            (scene, scene_hash),
             p.strategy.as_ref(),
             &p.settings,
             &p.choices,
@@ -513,7 +515,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     let written = report::write_images(&args, strategy.as_ref(), &settings, &result)?;
     let meta = report::metadata(
         &args,
-        &scene,
+        (&scene, &scene.content_hash()),
         strategy.as_ref(),
         &settings,
         &choices,

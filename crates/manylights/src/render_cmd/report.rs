@@ -80,7 +80,7 @@ pub(super) fn write_images(
 #[allow(clippy::too_many_arguments)]
 pub(super) fn metadata(
     args: &RenderArgs,
-    scene: &Scene,
+    (scene, scene_hash): (&Scene, &str),
     strategy: &dyn DirectLighting,
     settings: &RenderSettings,
     choices: &Choices,
@@ -101,7 +101,7 @@ pub(super) fn metadata(
     let mut meta = serde_json::json!({
         "scene": args.scene,
         "scene_stats": scene.stats,
-        "scene_hash": scene.content_hash(),
+        "scene_hash": scene_hash,
         "strategy": strategy.name(),
         "strategy_parameters": strategy.parameters(),
         "resolved_strategy": resolved,
