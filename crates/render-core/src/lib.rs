@@ -15,6 +15,7 @@ pub mod batch;
 pub mod bsdf;
 pub mod camera;
 pub mod colour;
+pub mod derived;
 pub mod emission_rays;
 pub mod error;
 pub mod estimator;

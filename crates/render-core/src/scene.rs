@@ -79,6 +79,8 @@ pub struct Scene {
     /// How points on triangle lights are drawn ([`Scene::sample_light`]): a render's choice,
     /// set before it starts.
     pub light_points: crate::light_points::LightPoints,
+    /// What strategies derived from this scene, kept for its next renders.
+    pub derived: crate::derived::Derived,
 }
 
 impl Scene {

@@ -410,6 +410,7 @@ impl SceneBuilder {
             render_hints: self.render_hints,
             accel,
             light_points: Default::default(),
+            derived: Default::default(),
         })
     }
 }

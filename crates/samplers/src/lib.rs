@@ -44,6 +44,7 @@ pub mod reuse;
 pub mod ris;
 pub mod rivals;
 mod scratch;
+pub mod shared_tree;
 pub mod strategy;
 pub mod work_counters;
 

@@ -4,6 +4,7 @@ use crate::light_strategy::LightStrategy;
 use crate::memo::OctMemo;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
+use crate::shared_tree::{SharedTree, shared_tree};
 use crate::strategy::Strategy;
 use crate::{StrategyError, StrategyOptions, resolve};
 use light_tree::{Cut, LightBounds, LightTree, NodeId, Rescaled, SplitParams};
@@ -54,7 +55,7 @@ pub enum TreeMode {
 /// Light-tree selection: one descent, or an E&K adaptive cut with one light per cluster.
 pub struct TreeSelection {
     /// The tree over the scene's lights (None without lights).
-    pub tree: Option<LightTree>,
+    pub tree: Option<SharedTree>,
     /// Single descent or adaptive splitting.
     pub mode: TreeMode,
 }
@@ -66,7 +67,7 @@ impl TreeSelection {
         let tree = if bounds.is_empty() {
             None
         } else {
-            Some(LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?)
+            Some(shared_tree(scene, bounds)?)
         };
         Ok(TreeSelection { tree, mode })
     }
@@ -338,7 +339,7 @@ pub const TREE_SPLIT_BSDF: Strategy = Strategy {
 
 impl crate::brdf_oriented::ls_technique::LsTechnique for TreeSelection {
     fn tree(&self) -> Option<&LightTree> {
-        self.tree.as_ref()
+        self.tree.as_deref()
     }
 
     fn prepare_ls(&self, scene: &Scene, sp: &ShadingPoint, one_descent: bool) -> TreeState {

@@ -72,7 +72,7 @@ impl DescentSelection {
         let tree = TreeSelection::new(scene, TreeMode::Single, units)?;
         let (pair_of, pair_count) = tree
             .tree
-            .as_ref()
+            .as_deref()
             .map_or_else(Default::default, learnt_pairs);
         let per_region = pair_count.max(1) * std::mem::size_of::<[NodeTally; 2]>();
         let max_regions = config.max_regions.min(MAX_TABLE_BYTES / per_region).max(1);
@@ -92,7 +92,7 @@ impl DescentSelection {
     }
 
     fn light_tree(&self) -> Option<&LightTree> {
-        self.tree.tree.as_ref()
+        self.tree.tree.as_deref()
     }
 
     /// The depth of the deepest learnt nodes (the children of the deepest learnt pairs).

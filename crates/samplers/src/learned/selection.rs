@@ -64,7 +64,7 @@ impl LearnedSelection {
     }
 
     fn light_tree(&self) -> Option<&LightTree> {
-        self.tree.tree.as_ref()
+        self.tree.tree.as_deref()
     }
 }
 
@@ -383,7 +383,7 @@ impl Learner for LearnedSelection {
 /// [`crate::brdf_oriented::pixel_memory::LEARNED`] on.
 impl crate::brdf_oriented::ls_technique::LsTechnique for LearnedSelection {
     fn tree(&self) -> Option<&LightTree> {
-        self.tree.tree.as_ref()
+        self.tree.tree.as_deref()
     }
 
     fn prepare_ls(&self, scene: &Scene, sp: &ShadingPoint, _: bool) -> LearnedState {

@@ -214,7 +214,7 @@ fn source(
     if name == RESTIR_BO.name {
         fn ris<C: brdf_integrals::CapIntegral>(
             opts: &StrategyOptions,
-            tree: Option<light_tree::LightTree>,
+            tree: Option<crate::shared_tree::SharedTree>,
             integral: C,
         ) -> Ris<C> {
             Ris {

@@ -30,9 +30,9 @@ use crate::brdf_oriented::technique::BoState;
 use crate::bsdf_sampling::sample_bsdf;
 use crate::mis::power2;
 use crate::scratch::Pooled;
+use crate::shared_tree::SharedTree;
 use crate::strategy::Strategy;
 use brdf_integrals::CapIntegral;
-use light_tree::LightTree;
 use render_core::Vec3;
 use render_core::colour::luminance;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
@@ -53,7 +53,7 @@ pub struct Ris<C: CapIntegral> {
     /// The strategy's registered name.
     pub name: String,
     /// The light tree (None without lights).
-    pub tree: Option<LightTree>,
+    pub tree: Option<SharedTree>,
     /// The cap-integral method behind the BO candidates.
     pub integral: C,
     /// How many candidates.

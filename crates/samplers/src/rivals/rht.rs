@@ -63,10 +63,11 @@ use crate::bsdf_sampling::sample_bsdf;
 use crate::mis::power2;
 use crate::ris::resample;
 use crate::scratch::Pooled;
+use crate::shared_tree::SharedTree;
+use crate::shared_tree::shared_tree;
 use crate::strategy::Strategy;
 use crate::tree_selection::{PowerUnits, light_bounds};
 use brdf_integrals::Sptd;
-use light_tree::LightTree;
 use render_core::Vec3;
 use render_core::colour::luminance;
 use render_core::estimator::{DirectLighting, SampleContext, ShadingPoint};
@@ -180,7 +181,7 @@ pub struct Rht {
     config: RhtConfig,
     /// The tree over the scene's lights and the gathering's records of its nodes (None
     /// without lights).
-    pub tree: Option<(LightTree, RhtNodes)>,
+    pub tree: Option<(SharedTree, RhtNodes)>,
     /// [`zero_split_bound`] of τ.
     zero_below: f64,
     /// The cap integrals of the BO weight (`rht-bo` only).
@@ -195,7 +196,7 @@ impl Rht {
         let tree = if bounds.is_empty() {
             None
         } else {
-            let tree = LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?;
+            let tree = shared_tree(scene, bounds)?;
             let nodes = RhtNodes::new(&tree);
             Some((tree, nodes))
         };

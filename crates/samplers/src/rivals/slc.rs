@@ -91,6 +91,8 @@ pub use super::slc_minmax::SlcDescent;
 use crate::light_strategy::LightStrategy;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
+use crate::shared_tree::SharedTree;
+use crate::shared_tree::shared_tree;
 use crate::strategy::Strategy;
 use crate::tree_selection::{PowerUnits, light_bounds};
 use brdf_integrals::Sptd;
@@ -194,7 +196,7 @@ pub fn cut_into(
 /// The selection of stochastic lightcuts: the cut of a shading point, one light per cut node.
 pub struct SlcSelection {
     /// The tree over the scene's lights (None without lights).
-    pub tree: Option<LightTree>,
+    pub tree: Option<SharedTree>,
     /// Most nodes in a cut (K).
     pub cut_size: usize,
     /// Squared floor of the box distance in the error bound, in scene units².
@@ -213,7 +215,7 @@ impl SlcSelection {
         let tree = if bounds.is_empty() {
             None
         } else {
-            Some(LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?)
+            Some(shared_tree(scene, bounds)?)
         };
         let radius = tree.as_ref().map_or(0.0, |t| t.node(t.root()).radius());
         let floor = DISTANCE_FLOOR * radius;

@@ -39,9 +39,11 @@ use crate::learned::regions::RegionGrid;
 use crate::learned::strategy::LearnedStrategy;
 use crate::learned::{Learner, PassWeights};
 use crate::selection::LightSelection;
+use crate::shared_tree::SharedTree;
+use crate::shared_tree::shared_tree;
 use crate::strategy::Strategy;
 use crate::tree_selection::{PowerUnits, light_bounds};
-use light_tree::{LightTree, NodeId, Rescaled};
+use light_tree::{NodeId, Rescaled};
 use render_core::Vec3;
 use render_core::estimator::{PIXEL_MEMORY, ShadingPoint};
 use render_core::rng::SampleStream;
@@ -53,7 +55,7 @@ pub use super::varl_options::{INITIAL_CUT, MAX_CUT, VarlOptions};
 /// The selection of `varl`: per-region learnt cuts and distributions.
 pub struct VarlSelection {
     /// The light tree (None without lights).
-    pub tree: Option<LightTree>,
+    pub tree: Option<SharedTree>,
     /// Shading point → region.
     pub grid: RegionGrid,
     /// Its parameters.
@@ -104,9 +106,9 @@ impl VarlSelection {
         let tree = if bounds.is_empty() {
             None
         } else {
-            Some(LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?)
+            Some(shared_tree(scene, bounds)?)
         };
-        let table = VarlTable::new(tree.as_ref(), opts.max_cut, opts.max_regions);
+        let table = VarlTable::new(tree.as_deref(), opts.max_cut, opts.max_regions);
         let (lo, _) = scene.bounds;
         Ok(VarlSelection {
             grid: RegionGrid::new(lo, scene.diagonal(), opts.cells_per_diagonal),

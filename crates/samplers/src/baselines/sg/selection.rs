@@ -6,6 +6,8 @@ use super::importance::SgShading;
 use crate::memo::NodeMemo;
 use crate::scratch::Pooled;
 use crate::selection::LightSelection;
+use crate::shared_tree::SharedTree;
+use crate::shared_tree::shared_tree;
 use crate::tree_selection::{PowerUnits, light_bounds};
 use light_tree::{LightTree, NodeId, Rescaled, SgEmitter, SgNodes};
 use render_core::estimator::ShadingPoint;
@@ -35,7 +37,7 @@ pub fn sg_emitters(scene: &Scene) -> Vec<SgEmitter> {
 
 /// The light tree with its SG lights (none without lights).
 pub struct SgTreeSelection {
-    tree: Option<(LightTree, SgNodes)>,
+    tree: Option<(SharedTree, SgNodes)>,
 }
 
 impl SgTreeSelection {
@@ -45,7 +47,7 @@ impl SgTreeSelection {
         if bounds.is_empty() {
             return Ok(SgTreeSelection { tree: None });
         }
-        let tree = LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?;
+        let tree = shared_tree(scene, bounds)?;
         let sg = SgNodes::build(&tree, &sg_emitters(scene)).map_err(|e| format!("SG tree: {e}"))?;
         Ok(SgTreeSelection {
             tree: Some((tree, sg)),
@@ -54,7 +56,7 @@ impl SgTreeSelection {
 
     /// The tree and its SG lights, if the scene has lights.
     pub fn tree(&self) -> Option<(&LightTree, &SgNodes)> {
-        self.tree.as_ref().map(|(t, s)| (t, s))
+        self.tree.as_ref().map(|(t, s)| (&**t, s))
     }
 }
 
