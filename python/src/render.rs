@@ -36,7 +36,7 @@ impl Scene {
 
     /// `manylights info --json` of the scene, as JSON text.
     fn info_json(&self) -> String {
-        manylights::scene_info_json(&self.spec, &self.inner).to_string()
+        manylights::scene_info_json((&self.spec, &self.hash), &self.inner).to_string()
     }
 
     fn __repr__(&self) -> String {

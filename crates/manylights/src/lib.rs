@@ -27,11 +27,12 @@ pub fn strategies_json() -> serde_json::Value {
         .collect()
 }
 
-/// A loaded scene's content hash, statistics, bounds and cameras: `manylights info --json`.
-pub fn scene_info_json(spec: &str, scene: &Scene) -> serde_json::Value {
+/// A loaded scene's content hash (`scene_hash`, [`Scene::content_hash`], which a caller that
+/// keeps it passes), statistics, bounds and cameras: `manylights info --json`.
+pub fn scene_info_json((spec, scene_hash): (&str, &str), scene: &Scene) -> serde_json::Value {
     serde_json::json!({
         "scene": spec,
-        "scene_hash": scene.content_hash(),
+        "scene_hash": scene_hash,
         "stats": scene.stats,
         "bounds": [scene.bounds.0.to_array(), scene.bounds.1.to_array()],
         "cameras": scene.cameras.iter().map(|c| &c.name).collect::<Vec<_>>(),

@@ -162,7 +162,7 @@ fn info(spec: &str, json: bool) -> anyhow::Result<()> {
     let scene = scene_formats::load_scene(spec, None)?;
     let s = &scene.stats;
     if json {
-        let v = manylights::scene_info_json(spec, &scene);
+        let v = manylights::scene_info_json((spec, &scene.content_hash()), &scene);
         println!("{}", serde_json::to_string_pretty(&v)?);
         return Ok(());
     }
