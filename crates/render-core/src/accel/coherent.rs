@@ -16,7 +16,7 @@
 use super::collapse::Wide;
 use super::node::{BoxRay, LEAF, NodeTest};
 use super::packet::LaneRay;
-use super::traverse::{fetch, insert_nearest_on_top, leaf_closest};
+use super::traverse::{insert_nearest_on_top, leaf_closest, pop_fetching_next};
 use super::{Hit, StreamRay, positive_zeros};
 use glam::Vec3;
 use std::mem::MaybeUninit;
@@ -122,14 +122,7 @@ fn closest_packet<N: NodeTest>(
     });
     let mut sp = 1;
     while sp > 0 {
-        sp -= 1;
-        // SAFETY: entries below `sp` were written.
-        let e = unsafe { stack[sp].assume_init() };
-        if sp > 0 {
-            // The next entry's memory starts loading while this one is tested.
-            // SAFETY: as above.
-            fetch(w, unsafe { stack[sp - 1].assume_init() }.code);
-        }
+        let e = pop_fetching_next(w, stack, &mut sp, |e| e.code);
         let mut rays = r.bound_for(e.rays, e.t);
         if rays == 0 {
             continue;

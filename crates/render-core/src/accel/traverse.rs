@@ -55,14 +55,7 @@ pub fn closest<N: NodeTest>(
     stack[0] = MaybeUninit::new(Entry { code: 0, t: tmin });
     let mut sp = 1;
     while sp > 0 {
-        sp -= 1;
-        // SAFETY: entries below `sp` were written.
-        let e = unsafe { stack[sp].assume_init() };
-        if sp > 0 {
-            // The next entry's memory starts loading while this one is tested.
-            // SAFETY: as above.
-            fetch(w, unsafe { stack[sp - 1].assume_init() }.code);
-        }
+        let e = pop_fetching_next(w, stack, &mut sp, |e| e.code);
         if e.t > tmax {
             continue;
         }
@@ -192,14 +185,7 @@ pub fn occluded<N: NodeTest>(
     stack[0] = MaybeUninit::new(Entry { code: 0, t: tmin });
     let mut sp = 1;
     while sp > 0 {
-        sp -= 1;
-        // SAFETY: entries below `sp` were written.
-        let e = unsafe { stack[sp].assume_init() };
-        if sp > 0 {
-            // The next entry's memory starts loading while this one is tested.
-            // SAFETY: as above.
-            fetch(w, unsafe { stack[sp - 1].assume_init() }.code);
-        }
+        let e = pop_fetching_next(w, stack, &mut sp, |e| e.code);
         if e.code & LEAF == 0 {
             let node = &w.nodes[e.code as usize];
             let (mask, _) = N::test(node, &br, tmax);
@@ -250,6 +236,25 @@ pub fn leaf_blocks(w: &Wide, code: u32, lr: &LaneRay, tmax: f32) -> bool {
         }
     }
     false
+}
+
+/// Pops the top entry (`*sp` > 0, entries below it written) and prefetches what the entry
+/// below it names (`code`), so that its memory loads while the popped one is tested.
+#[inline(always)]
+pub fn pop_fetching_next<E: Copy>(
+    w: &Wide,
+    stack: &[MaybeUninit<E>],
+    sp: &mut usize,
+    code: impl Fn(&E) -> u32,
+) -> E {
+    *sp -= 1;
+    // SAFETY: entries below the old `*sp` were written.
+    let e = unsafe { stack[*sp].assume_init() };
+    if *sp > 0 {
+        // SAFETY: as above.
+        fetch(w, code(&unsafe { stack[*sp - 1].assume_init() }));
+    }
+    e
 }
 
 /// Prefetches what `code` names: a node, or a leaf's first packet.
