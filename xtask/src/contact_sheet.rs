@@ -2,8 +2,17 @@
 //! (`mis3-adaptive`, unbiased default mode), into results/scenes/.
 use crate::experiments::compositing::{Canvas, auto_exposure, tonemap};
 use crate::experiments::manylights::{Manylights, repo_root};
+use clap::Parser;
 use std::path::Path;
 use std::process::{Command, ExitCode};
+
+/// No options: the scenes, size and spp are fixed so that the sheet is comparable across runs.
+#[derive(Parser)]
+#[command(
+    name = "cargo xtask contact-sheet",
+    about = "One labelled PNG of every scene (mis3-adaptive, 16 spp) into results/scenes/"
+)]
+struct Args {}
 
 /// Built-ins at their defaults, then the compositions of real assets (skipped when absent).
 const SCENES: [&str; 17] = [
@@ -32,14 +41,8 @@ const LABEL_H: u32 = 18;
 const COLUMNS: u32 = 4;
 const SPP: &str = "16";
 
-pub fn main(_args: &[String]) -> ExitCode {
-    match run() {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
+pub fn main(args: &[String]) -> ExitCode {
+    crate::run_subcommand(args, |_: &Args| run())
 }
 
 fn run() -> Result<(), String> {

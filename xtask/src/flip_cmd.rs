@@ -29,17 +29,7 @@ struct Args {
 }
 
 pub fn main(args: &[String]) -> ExitCode {
-    let a = match Args::try_parse_from(args) {
-        Ok(a) => a,
-        Err(e) => e.exit(),
-    };
-    match run(&a) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    crate::run_subcommand(args, run)
 }
 
 fn run(a: &Args) -> Result<(), String> {

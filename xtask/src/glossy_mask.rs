@@ -46,20 +46,7 @@ struct Args {
 }
 
 pub fn main(args: &[String]) -> ExitCode {
-    let a = match Args::try_parse_from(args) {
-        Ok(a) => a,
-        Err(e) => e.exit(),
-    };
-    match run(&a) {
-        Ok(n) => {
-            eprintln!("glossy pixels: {n}");
-            ExitCode::SUCCESS
-        }
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    crate::run_subcommand(args, |a| run(a).map(|n| eprintln!("glossy pixels: {n}")))
 }
 
 fn run(a: &Args) -> Result<usize, String> {

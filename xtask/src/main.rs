@@ -10,6 +10,22 @@ mod yardstick;
 #[global_allocator]
 static ALLOCATOR: scene_fuzz::CountingAllocator = scene_fuzz::CountingAllocator;
 
+/// A subcommand's entry: its arguments parsed by clap (which prints help or a usage error and
+/// exits), then `run`, whose error is printed as `error: …` with a failing exit code.
+pub(crate) fn run_subcommand<A: clap::Parser>(
+    args: &[String],
+    run: impl FnOnce(&A) -> Result<(), String>,
+) -> std::process::ExitCode {
+    let a = A::try_parse_from(args).unwrap_or_else(|e| e.exit());
+    match run(&a) {
+        Ok(()) => std::process::ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::ExitCode::FAILURE
+        }
+    }
+}
+
 fn main() -> std::process::ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {

@@ -75,17 +75,7 @@ fn parse_spp(s: &str) -> Result<(u32, u32), String> {
 }
 
 pub fn main(args: &[String]) -> ExitCode {
-    let a = match Args::try_parse_from(args) {
-        Ok(a) => a,
-        Err(e) => e.exit(),
-    };
-    match run(&a) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("error: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    crate::run_subcommand(args, run)
 }
 
 /// One renderer's CPU seconds at the low and high spp in one round.
