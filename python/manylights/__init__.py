@@ -5,6 +5,8 @@ experiment harness's own metrics, re-read the committed results, and sample ligh
 with the light tree and the BRDF-oriented selection. The Rust side is ``manylights._native``.
 """
 import json
+import os
+import warnings
 
 import numpy as np
 
@@ -14,7 +16,7 @@ from .lighttree import LightTree
 from .results import load_results
 
 __all__ = [
-    "Render", "Scene", "LightTree", "load_scene", "render", "strategies", "read_exr", "read_mask",
+    "Render", "Scene", "SceneWarning", "LightTree", "load_scene", "render", "strategies", "read_exr", "read_mask",
     "relmse", "mse", "flip", "load_results",
 ]
 
@@ -22,10 +24,18 @@ __all__ = [
 _OUTPUT_FLAGS = {"out", "png", "exposure", "aux", "stats", "quiet"}
 
 
+class SceneWarning(UserWarning):
+    """What a scene file holds that the renderer does not model (skipped), as the command
+    line prints it: ``load_scene`` warns once per item."""
+
+
 class Scene:
     """A loaded scene (``load_scene``); ``info()`` is ``manylights info --json``."""
 
     def __init__(self, native):
+        if not isinstance(native, _native.Scene):
+            raise TypeError("a Scene comes from manylights.load_scene(spec), not from "
+                            f"Scene({type(native).__name__})")
         self._native = native
 
     spec = property(lambda self: self._native.spec)
@@ -43,7 +53,18 @@ def load_scene(spec, camera=None, light_points=None):
     """A glTF, pbrt or TOML file, or ``builtin:NAME?key=value&...``; ``camera`` picks one by
     name; ``light_points`` is render's ``--light-points`` (how points on triangle lights are
     drawn), a property of the loaded scene."""
-    return Scene(_native.load_scene(str(spec), camera, light_points))
+    if not isinstance(spec, (str, os.PathLike)):
+        raise TypeError(f"spec must be a path or a 'builtin:NAME' string, not "
+                        f"{type(spec).__name__}")
+    scene = Scene(_native.load_scene(os.fspath(spec), camera, light_points))
+    for w in scene._native.warnings:
+        warnings.warn(w, SceneWarning, stacklevel=2)
+    return scene
+
+
+def _array(data, dtype, shape):
+    """A writable array of the bytes a native call returned."""
+    return np.frombuffer(data, dtype=dtype).reshape(shape).copy()
 
 
 class Render:
@@ -54,11 +75,11 @@ class Render:
 
     def __init__(self, out):
         h, w = out["height"], out["width"]
-        self.image = np.frombuffer(out["image"], dtype=np.float32).reshape(h, w, 3)
-        self.light_fraction = np.frombuffer(out["light_fraction"], dtype=np.float32).reshape(h, w)
+        self.image = _array(out["image"], np.float32, (h, w, 3))
+        self.light_fraction = _array(out["light_fraction"], np.float32, (h, w))
         # as the CLI's mask PNG quantises it, so that masks from Python and from files agree
         self.light_mask = np.floor(np.clip(self.light_fraction, 0, 1) * 255 + 0.5) > 0
-        self.aux = {k: np.frombuffer(v, dtype=np.float32).reshape(h, w) for k, v in out["aux"]}
+        self.aux = {k: _array(v, np.float32, (h, w)) for k, v in out["aux"]}
         self.metadata = json.loads(out["metadata"])
 
     def __repr__(self):
@@ -76,9 +97,13 @@ def _flags(strategy, spp, time_budget, seed, width, height, threads, params):
         if name in _OUTPUT_FLAGS:
             raise ValueError(f"`{name}` is the command line's output flag: ml.render returns "
                              "the image, light mask, aux channels and metadata instead")
+        if isinstance(value, (bool, np.bool_)):
+            value = bool(value)
         if value is None or value is False:
             continue
-        argv += [f"--{flag}"] if value is True else [f"--{flag}", str(value)]
+        # `--flag=value`, so that a negative number is read as the flag's value (and refused
+        # with the flag's own message), not as another flag
+        argv.append(f"--{flag}" if value is True else f"--{flag}={value}")
     return argv
 
 
@@ -94,10 +119,12 @@ def render(scene, strategy="power+bsdf", spp=None, time_budget=None, seed=0, wid
     for name in ("camera", "light_points"):
         if name in params and params.pop(name) != getattr(scene, name):
             raise ValueError(f"give {name} to load_scene, which loads the scene for it")
-    argv = [scene.spec, "--out", "unused.exr", "--light-points", scene.light_points]
+    argv = ["--out=unused.exr", f"--light-points={scene.light_points}"]
     if scene.camera is not None:
-        argv += ["--camera", scene.camera]
+        argv.append(f"--camera={scene.camera}")
     argv += _flags(strategy, spp, time_budget, seed, width, height, threads, params)
+    # the spec after `--`: one that starts with `-` is still the scene
+    argv += ["--", scene.spec]
     return Render(_native.render(scene._native, argv, progress))
 
 
@@ -109,15 +136,17 @@ def strategies():
 
 def read_exr(path):
     """A linear EXR as an H x W x 3 float32 array."""
-    w, h, data = _read_exr(str(path))
-    return np.frombuffer(data, dtype=np.float32).reshape(h, w, 3)
+    w, h, data = _read_exr(os.fspath(path))
+    return _array(data, np.float32, (h, w, 3))
 
 
 def read_mask(path, shape):
     """A light mask PNG (``render --aux``'s ``.mask.png``, a reference's ``mask.png``) of
     ``shape`` (H, W): True where the camera sees a light."""
-    h, w = shape[:2]
-    return ~np.frombuffer(_native.read_mask_png(str(path), w, h), dtype=bool).reshape(h, w)
+    h, w = (int(v) for v in shape[:2])
+    if h < 1 or w < 1:
+        raise ValueError(f"shape must be (H, W) with H, W ≥ 1, got {tuple(shape)}")
+    return ~np.frombuffer(_native.read_mask_png(os.fspath(path), w, h), dtype=bool).reshape(h, w)
 
 
 def _pair(img, ref, mask):
@@ -126,10 +155,14 @@ def _pair(img, ref, mask):
     if img.ndim != 3 or img.shape[2] != 3 or img.shape != ref.shape:
         raise ValueError(f"expected two H x W x 3 images, got {img.shape} and {ref.shape}")
     h, w = img.shape[:2]
+    if h == 0 or w == 0:
+        raise ValueError(f"the images are empty ({h} x {w})")
     if mask is not None:
         mask = np.ascontiguousarray(mask, dtype=bool)
         if mask.shape != (h, w):
             raise ValueError(f"the mask is {mask.shape}, the images {h} x {w}")
+        if not mask.any():
+            raise ValueError("the mask keeps no pixel: the error over no pixels is undefined")
         mask = mask.view(np.uint8)
     return img, ref, w, h, mask
 
@@ -152,5 +185,5 @@ def flip(img, ref, mask=None, map=False):
     img, ref, w, h, mask = _pair(img, ref, mask)
     data, mean = _native.hdr_flip(img, ref, w, h, mask)
     if map:
-        return mean, np.frombuffer(data, dtype=np.float32).reshape(h, w)
+        return mean, _array(data, np.float32, (h, w))
     return mean

@@ -66,13 +66,22 @@ pub fn hdr_flip<'py>(
     Ok((crate::f32_bytes(py, map.into_iter()), mean))
 }
 
+/// A file that could not be read: `FileNotFoundError` when it is not there, else `OSError`.
+fn file_error(path: &std::path::Path, message: String) -> PyErr {
+    if path.exists() {
+        pyo3::exceptions::PyOSError::new_err(message)
+    } else {
+        pyo3::exceptions::PyFileNotFoundError::new_err(message)
+    }
+}
+
 /// A linear EXR (one `render` wrote, or a reference): `(width, height, RGB float32 bytes)`.
 #[pyfunction]
 pub fn read_exr<'py>(py: Python<'py>, path: &str) -> PyResult<(u32, u32, Bound<'py, PyBytes>)> {
     let path = std::path::PathBuf::from(path);
     let (w, h, px) = py
         .detach(|| render_core::output::read_exr(&path))
-        .map_err(pyo3::exceptions::PyOSError::new_err)?;
+        .map_err(|e| file_error(&path, e))?;
     Ok((w, h, rgb_bytes(py, &px)))
 }
 
@@ -88,7 +97,7 @@ pub fn read_mask_png<'py>(
     let path = std::path::PathBuf::from(path);
     let unlit = py
         .detach(|| render_core::output::read_mask_png(&path, width, height))
-        .map_err(pyo3::exceptions::PyOSError::new_err)?;
+        .map_err(|e| file_error(&path, e))?;
     let bytes: Vec<u8> = unlit.into_iter().map(u8::from).collect();
     Ok(PyBytes::new(py, &bytes))
 }

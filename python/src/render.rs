@@ -35,6 +35,13 @@ impl Scene {
     }
 
     /// `manylights info --json` of the scene, as JSON text.
+    /// What the scene file holds that the renderer does not model (skipped), one line each, as
+    /// the command line prints them.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.inner.stats.warnings.clone()
+    }
+
     fn info_json(&self) -> String {
         manylights::scene_info_json((&self.spec, &self.hash), &self.inner).to_string()
     }
@@ -70,9 +77,7 @@ pub fn load_scene(
             let hash = scene.content_hash();
             Ok((scene, hash))
         })
-        .map_err(|e: render_core::error::SceneError| {
-            value_error(format!("{:#}", anyhow::Error::from(e)))
-        })?;
+        .map_err(scene_error)?;
     scene.light_points = points;
     Ok(Scene {
         inner: Arc::new(scene),
@@ -80,6 +85,23 @@ pub fn load_scene(
         camera,
         hash,
     })
+}
+
+/// A scene that cannot be loaded as a Python exception: `FileNotFoundError` for a file that is
+/// not there, `OSError` for one that cannot be read, `ValueError` for one that is not a scene
+/// (the command line's message in each).
+fn scene_error(e: render_core::error::SceneError) -> PyErr {
+    use render_core::error::SceneError;
+    let missing = match &e {
+        SceneError::Io { path, .. } => Some(!std::path::Path::new(path).exists()),
+        _ => None,
+    };
+    let message = format!("{:#}", anyhow::Error::from(e));
+    match missing {
+        Some(true) => pyo3::exceptions::PyFileNotFoundError::new_err(message),
+        Some(false) => pyo3::exceptions::PyOSError::new_err(message),
+        None => value_error(message),
+    }
 }
 
 /// `manylights strategies --json`, as JSON text.

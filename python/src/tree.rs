@@ -36,7 +36,8 @@ struct Points {
 impl Points {
     fn read(x: &Bound<'_, PyAny>, n: &Bound<'_, PyAny>, m: usize) -> PyResult<Points> {
         let (x, n) = (points(x, m, "x")?, points(n, m, "n")?);
-        if let Some(i) = (0..m).find(|&i| !x[i].is_finite() || !(n[i].length() > 0.0)) {
+        let bad = |i: usize| !x[i].is_finite() || !(n[i].is_finite() && n[i].length() > 0.0);
+        if let Some(i) = (0..m).find(|&i| bad(i)) {
             return Err(value_error(format!(
                 "point {i}: x must be finite and n a finite non-zero vector"
             )));

@@ -84,3 +84,28 @@ def test_bad_lights_and_queries_raise_value_errors():
         tree.sample([0, 0, 0], [0, 0, 0], [1])
     with pytest.raises(ValueError):
         tree.bo_sample([0, 0, 0], [0, 1, 0], [0, 1, 0], 0.0, [1])
+    with pytest.raises(ValueError, match="finite non-zero"):
+        tree.sample([0, 0, 0], [0, np.inf, 0], 0.5)
+    with pytest.raises(ValueError, match="radii"):
+        ml.LightTree(np.zeros((3, 3)), np.ones(3), radii=[1, 2])
+    with pytest.raises(ValueError, match="m x 3"):
+        tree.sample(np.zeros((2, 4, 3)), [0, 1, 0], 0.5)
+    with pytest.raises(ValueError, match="max_cut"):
+        tree.bo_sample([0, 0, 0], [0, 1, 0], [0, 1, 0], 0.3, [1], max_cut=-1)
+
+
+def test_random_numbers_and_indices_are_checked_not_coerced():
+    tree = lights(10)
+    x, n = [0, 0, 0], [0, 1, 0]
+    with pytest.raises(ValueError, match="floats must be in"):
+        tree.sample(x, n, np.array([0.5, np.nan]))
+    with pytest.raises(ValueError, match="non-negative"):
+        tree.sample(x, n, -1)
+    half = np.array([0.1, 0.5, 0.9])
+    assert np.array_equal(tree.sample(x, n, half.astype(np.float16))[0],
+                          tree.sample(x, n, half.astype(np.float16).astype(np.float64))[0])
+    for light in (1.7, "2"):
+        with pytest.raises(TypeError, match="integer"):
+            tree.pmf(x, n, light)
+        with pytest.raises(TypeError, match="integer"):
+            tree.bo_pmf(x, n, [0, 1, 0], 0.3, light)

@@ -51,6 +51,15 @@ def test_metrics_follow_their_definitions():
     assert fmap.shape == (6, 5) and 0 < score <= 1 and math.isclose(score, fmap.mean(), rel_tol=1e-5)
 
 
+def test_no_pixels_is_an_error_not_a_perfect_score():
+    img = np.ones((4, 4, 3), np.float32)
+    for metric in (ml.relmse, ml.mse, ml.flip):
+        with pytest.raises(ValueError, match="no pixel"):
+            metric(img, img, np.zeros((4, 4), bool))
+        with pytest.raises(ValueError, match="empty"):
+            metric(np.zeros((0, 0, 3)), np.zeros((0, 0, 3)))
+
+
 def test_load_results_reads_numbers_and_json(repo):
     cells = ml.load_results(repo / "results" / "quick" / "cells.csv")
     assert len(cells) > 100

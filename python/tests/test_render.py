@@ -63,9 +63,15 @@ def test_parameter_errors_are_value_errors_with_the_clis_message(cli, tmp_path, 
     assert str(e.value) == cli_error(cli, tmp_path, *args)
 
 
-def test_bad_input_raises_python_exceptions():
-    with pytest.raises(ValueError, match="no-such-file"):
+def test_bad_input_raises_python_exceptions(tmp_path):
+    with pytest.raises(FileNotFoundError, match="no-such-file"):
         ml.load_scene("no-such-file.glb")
+    with pytest.raises(OSError, match="not a regular file"):
+        ml.load_scene(tmp_path)
+    with pytest.raises(TypeError, match="spec"):
+        ml.load_scene(None)
+    with pytest.raises(TypeError, match="load_scene"):
+        ml.Scene(SPEC)
     with pytest.raises(ValueError, match="builtin"):
         ml.load_scene("builtin:no-such-builtin")
     with pytest.raises(ValueError, match="output"):
@@ -76,8 +82,57 @@ def test_bad_input_raises_python_exceptions():
         ml.render(ml.load_scene(SPEC), light_points="solid-angle")
     with pytest.raises(ValueError):
         ml.relmse(np.zeros((2, 2, 3)), np.zeros((2, 3, 3)))
-    with pytest.raises(OSError):
+    with pytest.raises(FileNotFoundError):
         ml.read_exr("no-such-file.exr")
+
+
+@pytest.mark.parametrize("name", ["spp", "seed", "width", "threads"])
+def test_a_negative_number_is_refused_by_its_flags_name(name):
+    kw = dict(spp=1, width=8, height=8)
+    kw[name] = -1
+    with pytest.raises(ValueError, match=f"--{name}"):
+        ml.render(SPEC, **kw)
+
+
+def test_numpy_booleans_are_flags_and_a_spec_may_start_with_a_dash(tmp_path, monkeypatch):
+    on = ml.render(SPEC, strategy="mis3-adaptive", spp=1, width=8, height=8, reproduce=np.bool_(True))
+    assert on.metadata["strategy_parameters"]["reproduce"] is True
+    off = ml.render(SPEC, strategy="mis3-adaptive", spp=1, width=8, height=8, reproduce=np.bool_(False))
+    assert off.metadata["strategy_parameters"]["reproduce"] is False
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "-tri.pbrt").write_text(TRIANGLE_PBRT)
+    with pytest.warns(ml.SceneWarning):
+        scene = ml.load_scene("-tri.pbrt")
+    r = ml.render(scene, spp=1, width=8, height=8)
+    assert r.metadata["scene"] == "-tri.pbrt"
+
+
+TRIANGLE_PBRT = """LookAt 0 0 5  0 0 0  0 1 0
+Camera "perspective" "float fov" [45]
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+AttributeBegin
+AreaLightSource "diffuse" "rgb L" [4 4 4]
+Shape "trianglemesh" "integer indices" [0 1 2] "point P" [-1 -1 0 1 -1 0 0 1 0]
+AttributeEnd
+Shape "trianglemesh" "integer indices" [0 1 2] "point P" [-3 -3 -1 3 -3 -1 0 3 -1]
+WorldEnd
+"""
+
+
+def test_what_a_scene_file_holds_unmodelled_is_a_warning(tmp_path):
+    path = tmp_path / "tri.pbrt"
+    path.write_text(TRIANGLE_PBRT)
+    with pytest.warns(ml.SceneWarning, match=r"tri.pbrt:4: LightSource \"infinite\""):
+        scene = ml.load_scene(path)
+    assert scene.info()["stats"]["warnings"] == [str(w) for w in scene._native.warnings]
+
+
+def test_returned_arrays_are_the_callers_to_change():
+    r = ml.render(SPEC, strategy="mis3-adaptive", spp=1, width=8, height=8)
+    assert r.aux
+    for a in [r.image, r.light_fraction, *r.aux.values(), ml.flip(r.image, r.image, map=True)[1]]:
+        a[...] = 0
 
 
 def test_the_scene_and_strategies_are_the_clis(cli):

@@ -125,11 +125,11 @@ pub fn read_mask_png(path: &Path, width: u32, height: u32) -> Result<Vec<bool>, 
     let img = image::open(path)
         .map_err(|e| format!("cannot read mask {}: {e}", path.display()))?
         .to_luma8();
-    if img.dimensions() != (width, height) {
+    let (w, h) = img.dimensions();
+    if (w, h) != (width, height) {
         return Err(format!(
-            "mask {} is {:?}, expected {width}x{height}",
+            "mask {} is {w} wide and {h} high, expected {width} wide and {height} high",
             path.display(),
-            img.dimensions()
         ));
     }
     Ok(img.pixels().map(|p| p.0[0] == 0).collect())
