@@ -1,5 +1,6 @@
 //! `manylights render`.
 mod knob_args;
+mod outputs;
 mod report;
 
 use anyhow::{Context, bail};
@@ -10,7 +11,7 @@ use render_core::emission_rays::EmissionRays;
 use render_core::estimator::DirectLighting;
 use render_core::filter::PixelFilter;
 use render_core::light_points::LightPoints;
-use render_core::output::write_json;
+use render_core::output::{FileSet, json_encoder};
 use render_core::render::{BudgetClock, Engine, RenderResult, RenderSettings, TimeBudget, render};
 use render_core::sampler::Sampler;
 use render_core::scene::Scene;
@@ -511,8 +512,10 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         choices,
         resolved,
     } = prepared;
+    outputs::check_planned(&args, &strategy.aux_channels())?;
     let result = render_with_progress(&args, &scene, strategy.as_ref(), &settings)?;
-    let written = report::write_images(&args, strategy.as_ref(), &settings, &result)?;
+    let mut files = FileSet::default();
+    let written = report::write_images(&args, strategy.as_ref(), &settings, &result, &mut files)?;
     let meta = report::metadata(
         &args,
         (&scene, &scene.content_hash()),
@@ -523,7 +526,12 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
         resolved,
         &written,
     );
-    write_json(&args.out.with_extension("json"), &meta).map_err(anyhow::Error::msg)?;
+    report::stage(
+        &mut files,
+        &outputs::json_path(&args.out),
+        json_encoder(&meta),
+    )?;
+    files.commit().map_err(anyhow::Error::msg)?;
     if args.stats || !args.quiet {
         report::print_summary(&result);
     }

@@ -1,8 +1,9 @@
 //! What `render` writes and prints once the image is made: the EXR, the PNG preview and the aux
 //! images, the JSON record of the render, and the summary on stderr.
+use super::outputs::sibling;
 use super::{BudgetClockArg, Choices, RenderArgs};
 use render_core::estimator::DirectLighting;
-use render_core::output::{write_exr, write_mask_png, write_png};
+use render_core::output::{FileSet, exr_encoder, mask_png_encoder, png_encoder};
 use render_core::render::{RenderResult, RenderSettings};
 use render_core::scene::Scene;
 use render_core::stats::StrategyCounter;
@@ -24,39 +25,41 @@ impl Written {
     }
 }
 
-fn sibling(out: &Path, suffix: &str) -> PathBuf {
-    let stem = out
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "render".into());
-    out.with_file_name(format!("{stem}{suffix}"))
-}
-
 /// The EXR, the PNG preview (`--png`) and, with `--aux`, the light mask and each aux channel as
-/// EXR and, where the strategy colours it, as PNG.
+/// EXR and, where the strategy colours it, as PNG, staged in `files` (put in place with the
+/// render's record, so that a failed write leaves the previous render's files as they were).
 pub(super) fn write_images(
     args: &RenderArgs,
     strategy: &dyn DirectLighting,
     settings: &RenderSettings,
     result: &RenderResult,
+    files: &mut FileSet,
 ) -> anyhow::Result<Written> {
     let (width, height) = (settings.width, settings.height);
-    write_exr(&args.out, width, height, &result.pixels).map_err(anyhow::Error::msg)?;
+    stage(files, &args.out, exr_encoder(width, height, &result.pixels))?;
     let exposure = args.exposure.unwrap_or_else(|| {
         render_core::colour::auto_exposure_scale(&result.pixels, &result.unlit_mask()).log2()
     });
     if let Some(p) = &args.png {
-        write_png(p, width, height, &result.pixels, exposure).map_err(anyhow::Error::msg)?;
+        stage(
+            files,
+            p,
+            png_encoder(width, height, &result.pixels, exposure),
+        )?;
     }
     let mut aux_files = Vec::new();
     if args.aux {
         let mask = sibling(&args.out, ".mask.png");
-        write_mask_png(&mask, width, height, &result.light_fraction).map_err(anyhow::Error::msg)?;
+        stage(
+            files,
+            &mask,
+            mask_png_encoder(width, height, &result.light_fraction),
+        )?;
         aux_files.push(mask);
         for (name, values) in &result.aux {
             let exr = sibling(&args.out, &format!(".{name}.exr"));
             let px: Vec<glam::Vec3> = values.iter().map(|&v| glam::Vec3::splat(v)).collect();
-            write_exr(&exr, width, height, &px).map_err(anyhow::Error::msg)?;
+            stage(files, &exr, exr_encoder(width, height, &px))?;
             aux_files.push(exr);
             let colours: Option<Vec<glam::Vec3>> = values
                 .iter()
@@ -64,7 +67,7 @@ pub(super) fn write_images(
                 .collect();
             if let Some(colours) = colours {
                 let png = sibling(&args.out, &format!(".{name}.png"));
-                write_png(&png, width, height, &colours, 0.0).map_err(anyhow::Error::msg)?;
+                stage(files, &png, png_encoder(width, height, &colours, 0.0))?;
                 aux_files.push(png);
             }
         }
@@ -73,6 +76,15 @@ pub(super) fn write_images(
         exposure,
         aux_files,
     })
+}
+
+/// One file of the render's set.
+pub(super) fn stage(
+    files: &mut FileSet,
+    path: &Path,
+    encode: impl FnOnce(&Path) -> Result<(), String>,
+) -> anyhow::Result<()> {
+    files.stage(path, encode).map_err(anyhow::Error::msg)
 }
 
 /// The render's JSON record: the scene, the strategy as built and as resolved, the settings and
