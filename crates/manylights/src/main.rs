@@ -86,7 +86,10 @@ fn main() -> ExitCode {
     host::exit_quietly_on_closed_pipe();
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => render_cmd::run(args),
+        Command::Render(args) => match render_cmd::run(args) {
+            Ok(code) => return code,
+            Err(e) => Err(e),
+        },
         Command::Info { scene, json } => info(&scene, json),
         Command::Convert { scene, out } => convert(&scene, &out),
         Command::Scenes => {

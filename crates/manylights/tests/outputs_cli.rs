@@ -112,3 +112,49 @@ fn a_directory_in_an_outputs_place_is_refused_and_the_last_render_kept_whole() {
     assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Ctrl-C (SIGINT) ends a long render as a spent time budget does: the samples done are
+/// written with their record, marked interrupted, and the exit code is 130.
+#[cfg(unix)]
+#[test]
+fn ctrl_c_writes_the_samples_done() {
+    let dir = temp_dir("ctrl-c");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_manylights"))
+        .current_dir(&dir)
+        .args([
+            "render",
+            "builtin:glossy-spheres?lights=16",
+            "--width",
+            "32",
+            "--height",
+            "24",
+            "--threads",
+            "1",
+            "--spp",
+            "10000000",
+            "--quiet",
+            "--out",
+            "c.exr",
+        ])
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("binary runs");
+    std::thread::sleep(std::time::Duration::from_secs(2));
+    let kill = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill runs");
+    assert!(kill.success());
+    let out = child.wait_with_output().expect("the render ends");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(130), "{err}");
+    assert!(err.contains("interrupted by Ctrl-C"), "{err}");
+    let meta: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.join("c.json")).expect("record written"))
+            .unwrap();
+    assert_eq!(meta["interrupted"], true, "{meta}");
+    let spp = meta["spp"].as_u64().unwrap();
+    assert!(spp >= 1 && spp < 10_000_000, "{meta}");
+    assert!(dir.join("c.exr").is_file());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -12,12 +12,16 @@ use render_core::estimator::DirectLighting;
 use render_core::filter::PixelFilter;
 use render_core::light_points::LightPoints;
 use render_core::output::{FileSet, json_encoder};
-use render_core::render::{BudgetClock, Engine, RenderResult, RenderSettings, TimeBudget, render};
+use render_core::render::{
+    BudgetClock, Engine, RenderResult, RenderSettings, TimeBudget, render_interruptible,
+};
 use render_core::sampler::Sampler;
 use render_core::scene::Scene;
 use render_core::splat::Reconstruction;
 use samplers::StrategyOptions;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 #[derive(Args)]
 pub struct RenderArgs {
@@ -407,11 +411,30 @@ fn render_with_progress(
         )
         .unwrap_or(ProgressStyle::default_bar()),
     );
-    let result = render(scene, strategy, settings, &|_, spp_done| {
-        bar.set_position(spp_done as u64)
-    })
+    let interrupt = interrupt_on_ctrl_c();
+    let result = render_interruptible(
+        scene,
+        strategy,
+        settings,
+        &|_, spp_done| bar.set_position(spp_done as u64),
+        &interrupt,
+    )
     .map_err(anyhow::Error::msg)?;
     bar.finish_and_clear();
+    if result.interrupted {
+        eprintln!(
+            "warning: interrupted by Ctrl-C: the image holds the samples done, {} full passes{}{}",
+            result.spp,
+            match result.partial_pixels {
+                0 => String::new(),
+                n => format!(" and {n} pixels of one more"),
+            },
+            match settings.spp {
+                Some(n) => format!(", of the {n} asked for"),
+                None => String::new(),
+            }
+        );
+    }
     if result.unsampled_pixels() > 0 {
         eprintln!(
             "warning: the time budget ran out inside the first pass: {} of {} pixels have no sample and are black",
@@ -420,6 +443,28 @@ fn render_with_progress(
         );
     }
     Ok(result)
+}
+
+/// A flag that Ctrl-C sets, so that the render ends as a spent time budget ends it and its
+/// samples are written; a second Ctrl-C quits at once (exit code 130, nothing written).
+fn interrupt_on_ctrl_c() -> Arc<AtomicBool> {
+    let flag = Arc::new(AtomicBool::new(false));
+    let set = flag.clone();
+    let handler = move || {
+        if set.swap(true, Ordering::Relaxed) {
+            std::process::exit(130);
+        }
+        eprintln!(
+            "\ninterrupted: finishing the work units under way to write the samples done \
+             (Ctrl-C again to quit without them)"
+        );
+    };
+    // Only the first render of a process can install it (`ctrlc` allows one handler); a
+    // host that renders again keeps the first flag's handler, which this render then misses.
+    if ctrlc::set_handler(handler).is_err() {
+        return Arc::new(AtomicBool::new(false));
+    }
+    flag
 }
 
 /// `render`'s flags from `argv` (without the program and command names), parsed as the command
@@ -492,7 +537,9 @@ impl Prepared {
     }
 }
 
-pub fn run(args: RenderArgs) -> anyhow::Result<()> {
+/// `manylights render`: the exit code is 0, or 130 for a render that Ctrl-C ended early (its
+/// samples written all the same).
+pub fn run(args: RenderArgs) -> anyhow::Result<std::process::ExitCode> {
     check_args(&args)?;
     check_outputs(&args)?;
     let mut scene = scene_formats::load_scene(&args.scene, args.camera.as_deref())?;
@@ -538,5 +585,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<()> {
     if args.stats {
         report::print_stats(&result, &strategy.counters());
     }
-    Ok(())
+    Ok(match result.interrupted {
+        true => std::process::ExitCode::from(130),
+        false => std::process::ExitCode::SUCCESS,
+    })
 }

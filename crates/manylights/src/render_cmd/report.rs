@@ -165,6 +165,8 @@ pub(super) fn metadata(
         .image_space()
         .is_some_and(|s| s.correlates_passes())
         .into();
+    // Ended early by Ctrl-C: the image holds the samples done (`spp`, `partial_pass_pixels`).
+    meta["interrupted"] = result.interrupted.into();
     meta
 }
 

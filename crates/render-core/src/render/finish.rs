@@ -36,6 +36,9 @@ pub struct RenderResult {
     /// Camera samples of the strategy's pilot (`crate::pilot`; not in the image, their work in
     /// `counters` and the seconds).
     pub pilot_samples: u64,
+    /// Ended early by its caller ([`super::render_interruptible`]): the image holds the samples
+    /// done, as a spent time budget's does.
+    pub interrupted: bool,
     /// Pixels without any sample (a budget spent inside the first pass).
     unsampled: usize,
 }
@@ -63,6 +66,7 @@ pub(super) struct RunInfo {
     pub(super) cpu_start: Option<f64>,
     pub(super) threads: usize,
     pub(super) pilot_samples: u64,
+    pub(super) interrupted: bool,
 }
 
 /// The image and its diagnostics from the passes' accumulators.
@@ -106,6 +110,7 @@ pub(super) fn finish(
         passes: passes.passes,
         threads: run.threads,
         pilot_samples: run.pilot_samples,
+        interrupted: run.interrupted,
         unsampled: image.unsampled,
     }
 }

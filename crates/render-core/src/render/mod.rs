@@ -63,8 +63,15 @@ pub fn render(
 /// The error of a render stopped by its `cancel` flag.
 pub const CANCELLED: &str = "the render was cancelled";
 
-/// [`render`] that another thread can stop by setting `cancel` (an interactive host's Ctrl-C):
-/// the worker threads stop claiming work units and the render returns [`CANCELLED`] within one
+/// How another thread may end a render early: `cancel` drops it, `finish` keeps its work.
+#[derive(Clone, Copy)]
+struct Stops<'a> {
+    cancel: &'a AtomicBool,
+    finish: &'a AtomicBool,
+}
+
+/// [`render`] that another thread can stop by setting `cancel` (a Python host's Ctrl-C): the
+/// worker threads stop claiming work units and the render returns [`CANCELLED`] within one
 /// unit per thread. Until it is set, the image is [`render`]'s, bit for bit.
 pub fn render_cancellable(
     scene: &Scene,
@@ -72,6 +79,51 @@ pub fn render_cancellable(
     settings: &RenderSettings,
     progress: &(dyn Fn(u32, u32) + Sync),
     cancel: &AtomicBool,
+) -> Result<RenderResult, String> {
+    let finish = AtomicBool::new(false);
+    render_stopping(
+        scene,
+        strategy,
+        settings,
+        progress,
+        Stops {
+            cancel,
+            finish: &finish,
+        },
+    )
+}
+
+/// [`render`] that another thread can end early by setting `finish` (the command line's
+/// Ctrl-C), keeping what it has done: the worker threads stop claiming work units, as when a
+/// time budget is spent, and the image holds the passes done and the units of the pass under
+/// way (`partial_pixels`), marked [`RenderResult::interrupted`]. Until it is set, the image is
+/// [`render`]'s, bit for bit.
+pub fn render_interruptible(
+    scene: &Scene,
+    strategy: &dyn DirectLighting,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u32, u32) + Sync),
+    finish: &AtomicBool,
+) -> Result<RenderResult, String> {
+    let cancel = AtomicBool::new(false);
+    render_stopping(
+        scene,
+        strategy,
+        settings,
+        progress,
+        Stops {
+            cancel: &cancel,
+            finish,
+        },
+    )
+}
+
+fn render_stopping(
+    scene: &Scene,
+    strategy: &dyn DirectLighting,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(u32, u32) + Sync),
+    stops: Stops,
 ) -> Result<RenderResult, String> {
     settings.check()?;
     let image_space = strategy.image_space();
@@ -116,7 +168,7 @@ pub fn render_cancellable(
         counters.merge(&c);
         pilot_samples = n;
     }
-    if cancel.load(Ordering::Relaxed) {
+    if stops.cancel.load(Ordering::Relaxed) {
         return Err(CANCELLED.into());
     }
     passes.run(
@@ -124,13 +176,14 @@ pub fn render_cancellable(
         &pool,
         clock.as_ref(),
         &mut counters,
-        (progress, cancel),
+        (progress, stops),
     )?;
     let run = RunInfo {
         start,
         cpu_start,
         threads,
         pilot_samples,
+        interrupted: stops.finish.load(Ordering::Relaxed),
     };
     Ok(finish(&job, &passes, counters, run))
 }

@@ -54,14 +54,14 @@ impl Passes {
 
     /// Runs passes until the sample count is reached or the budget stops one inside; calls
     /// `progress` after each with (passes done, full passes so far). A set `cancel` ends it
-    /// with [`super::CANCELLED`].
+    /// with [`super::CANCELLED`]; a set `finish` ends it as a spent budget does.
     pub(super) fn run(
         &mut self,
         job: &PassJob,
         pool: &rayon::ThreadPool,
         clock: Option<&BudgetClockReader>,
         counters: &mut Counters,
-        (progress, cancel): (&(dyn Fn(u32, u32) + Sync), &AtomicBool),
+        (progress, stops): (&(dyn Fn(u32, u32) + Sync), super::Stops),
     ) -> Result<(), String> {
         let stop = AtomicBool::new(false);
         let image_space = job.strategy.image_space();
@@ -72,7 +72,7 @@ impl Passes {
             {
                 break;
             }
-            if stop.load(Ordering::Relaxed) {
+            if stop.load(Ordering::Relaxed) || stops.finish.load(Ordering::Relaxed) {
                 break;
             }
             // An image-space pass is never cut short: another one starts while at least half
@@ -98,9 +98,9 @@ impl Passes {
                     let n_units = job.grid.len().div_ceil(UNIT_PIXELS);
                     (n_units, n_units)
                 }
-                None => self.pass(job, pool, (clock, &stop, cancel), pass_weight, counters),
+                None => self.pass(job, pool, (clock, &stop, stops), pass_weight, counters),
             };
-            if cancel.load(Ordering::Relaxed) {
+            if stops.cancel.load(Ordering::Relaxed) {
                 return Err(super::CANCELLED.into());
             }
             if done == 0 {
@@ -131,7 +131,7 @@ impl Passes {
         &mut self,
         job: &PassJob,
         pool: &rayon::ThreadPool,
-        (clock, stop, cancel): (Option<&BudgetClockReader>, &AtomicBool, &AtomicBool),
+        (clock, stop, stops): (Option<&BudgetClockReader>, &AtomicBool, super::Stops),
         pass_weight: f64,
         counters: &mut Counters,
     ) -> (usize, usize) {
@@ -146,7 +146,7 @@ impl Passes {
             .collect();
         let next_unit = AtomicUsize::new(0);
         let pass_counters: Vec<Counters> =
-            pool.broadcast(|_| claim_units(job, &units, &next_unit, (clock, stop, cancel), sample));
+            pool.broadcast(|_| claim_units(job, &units, &next_unit, (clock, stop, stops), sample));
         for c in &pass_counters {
             counters.merge(c);
         }
@@ -163,18 +163,22 @@ impl Passes {
 }
 
 /// One worker thread's share of a pass: units claimed in order until none is left or the
-/// budget is spent or the render cancelled; returns what it counted.
+/// budget is spent or the render cancelled or finished; returns what it counted.
 fn claim_units(
     job: &PassJob,
     units: &Units,
     next_unit: &AtomicUsize,
-    (clock, stop, cancel): (Option<&BudgetClockReader>, &AtomicBool, &AtomicBool),
+    (clock, stop, stops): (Option<&BudgetClockReader>, &AtomicBool, super::Stops),
     sample: (u64, f64),
 ) -> Counters {
     let mut c = Counters::default();
     let mut last_cpu_read = None;
     loop {
-        if cancel.load(Ordering::Relaxed) {
+        if stops.cancel.load(Ordering::Relaxed) {
+            break;
+        }
+        if stops.finish.load(Ordering::Relaxed) {
+            stop.store(true, Ordering::Relaxed);
             break;
         }
         if let Some(clock) = clock

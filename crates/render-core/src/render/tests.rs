@@ -509,3 +509,26 @@ fn a_cancelled_render_returns_the_cancelled_error() {
     let a = render_cancellable(&scene, &OneLight, &s3, &|_, _| {}, &unset).unwrap();
     assert_eq!(a.pixels, run(&scene, Some(3), None, 1).pixels);
 }
+
+/// A finish flag set by the progress callback after the second pass ends the render with
+/// those two passes' image, bit for bit, marked interrupted; an unset one changes nothing.
+#[test]
+fn a_finished_render_keeps_the_passes_done() {
+    let scene = test_scene();
+    let s = settings(&scene, Some(50), None, 2, Sampler::Independent);
+    let finish = AtomicBool::new(false);
+    let stop_after_two = |passes: u32, _| {
+        if passes == 2 {
+            finish.store(true, Ordering::Relaxed);
+        }
+    };
+    let r = render_interruptible(&scene, &OneLight, &s, &stop_after_two, &finish).unwrap();
+    assert!(r.interrupted);
+    assert_eq!((r.spp, r.partial_pixels, r.passes), (2, 0, 2));
+    assert_eq!(r.pixels, run(&scene, Some(2), None, 1).pixels);
+    let unset = AtomicBool::new(false);
+    let s3 = settings(&scene, Some(3), None, 2, Sampler::Independent);
+    let a = render_interruptible(&scene, &OneLight, &s3, &|_, _| {}, &unset).unwrap();
+    assert!(!a.interrupted);
+    assert_eq!(a.pixels, run(&scene, Some(3), None, 1).pixels);
+}
