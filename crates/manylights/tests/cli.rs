@@ -285,6 +285,31 @@ fn assert_clean_failure(dir: &Path, args: &[&str], expect: &str) {
     assert!(left.is_empty(), "{args:?} left files: {left:?}");
 }
 
+/// The largest image's bytes overflow 64 bits: the refusal still gives its true size per pixel.
+#[test]
+fn a_huge_images_refusal_counts_its_bytes() {
+    let dir = temp_dir("huge");
+    let out = dir.join("x.exr");
+    let o = manylights(&[
+        "render",
+        SCENE,
+        "--spp",
+        "1",
+        "--width",
+        "4294967295",
+        "--height",
+        "4294967295",
+        "--quiet",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains(" bytes per pixel)") && !err.contains("(0 bytes"),
+        "{err}"
+    );
+}
+
 #[test]
 fn bad_input_fails_cleanly() {
     let dir = temp_dir("bad");
@@ -312,6 +337,7 @@ fn bad_input_fails_cleanly() {
         // refused from the memory estimate, before anything is allocated
         (huge, "100000×100000 render needs about"),
         (r(missing.to_str().unwrap(), &[]), "missing.gltf"),
+        (r(SCENE, &["--threads", "100000"]), "more than the 4096"),
         (r(garbage.to_str().unwrap(), &[]), "garbage.glb"),
         (
             r(SCENE, &["--strategy", "no-such-strategy"]),

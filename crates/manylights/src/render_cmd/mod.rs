@@ -278,6 +278,15 @@ pub fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
     if args.threads == Some(0) {
         bail!("--threads must be at least 1");
     }
+    if let Some(t) = args
+        .threads
+        .filter(|&t| t > render_core::render::MAX_THREADS)
+    {
+        bail!(
+            "--threads {t} is more than the {} a render may ask for",
+            render_core::render::MAX_THREADS
+        );
+    }
     if args.exposure.is_some_and(|e| !e.is_finite()) {
         bail!("--exposure must be a finite number of stops");
     }

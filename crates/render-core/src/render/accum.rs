@@ -21,9 +21,13 @@ pub(super) struct PixelAccum {
 /// then the finished image, its variance, light mask and `aux_channels` maps, and an output
 /// image being encoded (EXR or PNG).
 pub fn memory_estimate(width: u32, height: u32, aux_channels: usize) -> u64 {
+    (width as u64 * height as u64).saturating_mul(bytes_per_pixel(aux_channels))
+}
+
+/// A pixel's share of [`memory_estimate`].
+fn bytes_per_pixel(aux_channels: usize) -> u64 {
     let finished = 3 * size_of::<Vec3>() + size_of::<f32>() * (1 + aux_channels);
-    let per_pixel = size_of::<PixelAccum>() + finished;
-    width as u64 * height as u64 * per_pixel as u64
+    (size_of::<PixelAccum>() + finished) as u64
 }
 
 /// Refuses, before anything is allocated, a render that needs more memory than the machine
@@ -39,14 +43,14 @@ pub(super) fn check_memory_with(
     aux_channels: usize,
     extra_per_pixel: usize,
 ) -> Result<(), String> {
-    let need = memory_estimate(width, height, aux_channels)
-        + width as u64 * height as u64 * extra_per_pixel as u64;
+    let per_pixel = bytes_per_pixel(aux_channels) + extra_per_pixel as u64;
+    // Saturating: a 2^32 × 2^32 image's bytes do not fit 64 bits.
+    let need = (width as u64 * height as u64).saturating_mul(per_pixel);
     match host::physical_memory_bytes() {
         Some(have) if need > have => Err(format!(
-            "a {width}×{height} render needs about {:.1} GiB ({} bytes per pixel), more than \
-             this machine's {:.1} GiB of memory",
-            need as f64 / GIB,
-            need / (width as u64 * height as u64),
+            "a {width}×{height} render needs about {:.1} GiB ({per_pixel} bytes per pixel), more \
+             than this machine's {:.1} GiB of memory",
+            width as f64 * height as f64 * per_pixel as f64 / GIB,
             have as f64 / GIB
         )),
         _ => Ok(()),

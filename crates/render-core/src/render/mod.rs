@@ -35,7 +35,7 @@ mod unit_batch;
 pub use accum::{check_memory, memory_estimate};
 pub use finish::RenderResult;
 pub use pass_job::UNIT_PIXELS;
-pub use settings::{BudgetClock, Engine, RenderSettings, TimeBudget};
+pub use settings::{BudgetClock, Engine, MAX_THREADS, RenderSettings, TimeBudget};
 pub use shading::shading_point;
 
 use crate::estimator::{DirectLighting, MAX_AUX};
@@ -133,10 +133,6 @@ fn render_stopping(
         strategy.aux_channels().len(),
         image_space.map_or(0, |s| image_pass::image_pass_bytes(s.bytes_per_pixel())),
     )?;
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(settings.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| format!("cannot start worker threads: {e}"))?;
     let (w, h) = (settings.width as usize, settings.height as usize);
     let job = PassJob {
         scene,
@@ -146,6 +142,11 @@ fn render_stopping(
         n_aux: strategy.aux_channels().len().min(MAX_AUX),
         grid: SampleGrid::new(w, h, settings.reconstruction, &settings.filter),
     };
+    let units = job.grid.len().div_ceil(UNIT_PIXELS);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(settings::worker_threads(settings.threads, units))
+        .build()
+        .map_err(|e| format!("cannot start worker threads: {e}"))?;
     if let Some(spp) = settings.spp {
         let grid = (job.grid.width as u32, job.grid.height as u32);
         settings.sampler.check_image(grid, spp)?;

@@ -90,6 +90,16 @@ pub enum BudgetClock {
     Cpu,
 }
 
+/// Most worker threads a render may ask for (a typo should not start a hundred thousand).
+pub const MAX_THREADS: usize = 4096;
+
+/// The worker threads a render runs on: those asked for (all cores by default), but no more
+/// than it has work units to share (more would only wait; the image is the same either way).
+pub(super) fn worker_threads(asked: Option<usize>, units: usize) -> usize {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    asked.unwrap_or(cores).min(units.max(1))
+}
+
 impl RenderSettings {
     /// Refuses settings no render can follow, with the reason.
     pub(super) fn check(&self) -> Result<(), String> {
@@ -98,6 +108,13 @@ impl RenderSettings {
         }
         if self.spp == Some(0) {
             return Err("spp must be at least 1".into());
+        }
+        if let Some(t) = self.threads
+            && !(1..=MAX_THREADS).contains(&t)
+        {
+            return Err(format!(
+                "threads must be between 1 and {MAX_THREADS}, not {t}"
+            ));
         }
         if self.spp.is_none() && self.time_budget.is_none() {
             return Err("give spp, a time budget, or both".into());
@@ -166,5 +183,19 @@ impl BudgetClockReader {
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod thread_tests {
+    use super::*;
+
+    /// The threads asked for, but no more than the work units; a bad count is refused.
+    #[test]
+    fn a_render_runs_on_no_more_threads_than_work_units() {
+        assert_eq!(worker_threads(Some(4000), 4), 4);
+        assert_eq!(worker_threads(Some(2), 100), 2);
+        assert_eq!(worker_threads(Some(3), 0), 1);
+        assert!(worker_threads(None, 1_000_000) >= 1);
     }
 }
