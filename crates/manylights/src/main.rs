@@ -145,11 +145,18 @@ fn list_scenes() {
 fn convert(spec: &str, out: &std::path::Path) -> anyhow::Result<()> {
     // Binary glTF whatever the name: a .gltf name would send other tools to their JSON reader.
     render_cmd::check_extension(out, ("convert", "binary glTF", "glb"), "")?;
+    render_cmd::check_output_file(out, "convert's output")?;
     let scene = scene_formats::load_scene(spec, None)?;
     for w in &scene.stats.warnings {
         eprintln!("warning: {w}");
     }
-    for w in scene_formats::gltf_writer::write_glb(&scene, out)? {
+    // The writer's errors come as a scene's I/O error, whose text says "read": its message
+    // already names the file written.
+    let written = scene_formats::gltf_writer::write_glb(&scene, out).map_err(|e| match e {
+        render_core::error::SceneError::Io { message, .. } => anyhow::Error::msg(message),
+        other => other.into(),
+    })?;
+    for w in written {
         eprintln!("warning: {w}");
     }
     println!(
@@ -210,6 +217,21 @@ fn info(spec: &str, json: bool) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Warns of an image's NaN or infinite pixels, which make its errors NaN: how many and the
+/// first (a render should have none; a reference with them is no reference).
+fn warn_non_finite(path: &std::path::Path, px: &[glam::Vec3], width: usize) {
+    let bad = px.iter().filter(|p| !p.is_finite()).count();
+    if let Some(i) = px.iter().position(|p| !p.is_finite()) {
+        eprintln!(
+            "warning: {} has {bad} pixels that are not finite (NaN or infinite), the first at \
+             ({}, {}): the errors involving them are NaN",
+            path.display(),
+            i % width,
+            i / width
+        );
+    }
+}
+
 fn compare(
     image: &std::path::Path,
     reference: &std::path::Path,
@@ -226,6 +248,9 @@ fn compare(
             image.display(),
             reference.display()
         );
+    }
+    for (path, px) in [(image, &x), (reference, &r)] {
+        warn_non_finite(path, px, w as usize);
     }
     let all = error_metrics(&x, &r, None);
     let mut unlit_mask: Option<Vec<bool>> = None;

@@ -452,6 +452,29 @@ fn closed_stdout_ends_quietly() {
     assert!(!err.contains("panicked"), "{err}");
 }
 
+/// A NaN pixel makes compare's errors NaN; it says so, with where.
+#[test]
+fn compare_warns_of_pixels_that_are_not_finite() {
+    let dir = temp_dir("compare-nan");
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    let mut px = vec![glam::Vec3::ONE; 6];
+    render_core::output::write_exr(&b, 3, 2, &px).unwrap();
+    px[4] = glam::Vec3::new(f32::NAN, 1.0, 1.0);
+    render_core::output::write_exr(&a, 3, 2, &px).unwrap();
+    let o = manylights(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("has 1 pixels that are not finite") && err.contains("the first at (1, 1)"),
+        "{err}"
+    );
+    let o = manylights(&["compare", b.to_str().unwrap(), b.to_str().unwrap()]);
+    assert!(
+        o.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
 #[test]
 fn compare_reports_error_against_a_reference() {
     let dir = temp_dir("compare");
@@ -742,6 +765,17 @@ fn pbrt_scenes_info_convert_render_and_errors() {
         "{err}"
     );
     assert!(!gltf.exists(), "a refused conversion writes nothing");
+    for (out, expect) in [
+        (dir.join("no-such-dir/x.glb"), "output directory"),
+        (dir.to_path_buf(), "must end in .glb"),
+        (dir.join("dir.glb"), "(convert's output) is a directory"),
+    ] {
+        let _ = std::fs::create_dir(dir.join("dir.glb"));
+        let o = manylights(&["convert", s, out.to_str().unwrap()]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(expect), "{err}");
+        assert!(!err.contains("cannot read scene file"), "{err}");
+    }
     let glb = dir.join("lamp.glb");
     let o = manylights(&["convert", s, glb.to_str().unwrap()]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
@@ -1045,4 +1079,38 @@ fn render_help_documents_every_flag() {
         assert!(same_line || next_line, "no help for `{}`", t);
     }
     assert!(flags > 30, "only {flags} flags found in:\n{text}");
+}
+
+/// A flag that changes nothing in this render is warned about, not silently dropped.
+#[test]
+fn flags_that_do_nothing_are_warned_about() {
+    let dir = temp_dir("ignored");
+    let out = dir.join("x.exr");
+    let o = manylights(&[
+        "render",
+        SCENE,
+        "--spp",
+        "1",
+        "--width",
+        "8",
+        "--height",
+        "8",
+        "--exposure",
+        "2",
+        "--budget-clock",
+        "cpu",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("--exposure sets the --png preview's brightness"),
+        "{err}"
+    );
+    assert!(
+        err.contains("--budget-clock says what --time-budget counts"),
+        "{err}"
+    );
+    assert!(err.contains("(1 pass)"), "{err}");
 }

@@ -242,6 +242,18 @@ fn sampler_parser() -> impl clap::builder::TypedValueParser<Value = Sampler> {
         .map(|s| Sampler::from_name(&s).expect("a listed name"))
 }
 
+/// Fails early, before loading anything, when the file `flag` names cannot be written: a
+/// directory in its place, or a directory that is missing or read-only.
+pub fn check_output_file(path: &Path, flag: &str) -> anyhow::Result<()> {
+    if path.is_dir() {
+        bail!(
+            "{} ({flag}) is a directory: name a file to write",
+            path.display()
+        );
+    }
+    check_writable(path)
+}
+
 /// Fails early, before a long render, when the output cannot be written.
 fn check_writable(path: &Path) -> anyhow::Result<()> {
     let dir = match path.parent() {
@@ -291,6 +303,19 @@ pub fn check_args(args: &RenderArgs) -> anyhow::Result<()> {
         bail!("--exposure must be a finite number of stops");
     }
     Ok(())
+}
+
+/// Flags given that change nothing in this render, each with why.
+fn ignored_flags(args: &RenderArgs) -> Vec<&'static str> {
+    let mut ignored = Vec::new();
+    if args.exposure.is_some() && args.png.is_none() {
+        ignored
+            .push("--exposure sets the --png preview's brightness; without --png it does nothing");
+    }
+    if matches!(args.budget_clock, BudgetClockArg::Cpu) && args.time_budget.is_none() {
+        ignored.push("--budget-clock says what --time-budget counts; without one it does nothing");
+    }
+    ignored
 }
 
 /// That the output files are named for what they hold and can be written, before a long
@@ -551,6 +576,11 @@ impl Prepared {
 pub fn run(args: RenderArgs) -> anyhow::Result<std::process::ExitCode> {
     check_args(&args)?;
     check_outputs(&args)?;
+    if !args.quiet {
+        for w in ignored_flags(&args) {
+            eprintln!("warning: {w}");
+        }
+    }
     let mut scene = scene_formats::load_scene(&args.scene, args.camera.as_deref())?;
     scene.light_points = args.strategy.light_points;
     if !args.quiet {

@@ -175,7 +175,7 @@ pub(super) fn print_summary(result: &RenderResult) {
     let secs = result.wall_seconds.max(1e-9);
     let closest = result.counters.camera_rays + result.counters.bsdf_rays;
     eprintln!(
-        "{} spp{} in {:.2} s ({} passes); closest-hit rays {:.3} M/s, shadow rays {:.3} M/s (whole render, shading included)",
+        "{} spp{} in {:.2} s ({} pass{}); closest-hit rays {:.3} M/s, shadow rays {:.3} M/s (whole render, shading included)",
         result.spp,
         if result.partial_pixels > 0 {
             format!(" + {} pixels of one more", result.partial_pixels)
@@ -184,6 +184,7 @@ pub(super) fn print_summary(result: &RenderResult) {
         },
         secs,
         result.passes,
+        if result.passes == 1 { "" } else { "es" },
         closest as f64 / secs / 1e6,
         result.counters.shadow_rays as f64 / secs / 1e6
     );
