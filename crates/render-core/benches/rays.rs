@@ -98,15 +98,18 @@ fn million_triangle_scene() -> Scene {
         m,
     )
     .unwrap();
-    b.add_camera(Camera::look_at(
-        "c",
-        Vec3::new(0.0, 8.0, 22.0),
-        Vec3::ZERO,
-        Vec3::Y,
-        0.8,
-        512,
-        512,
-    ));
+    b.add_camera(
+        Camera::look_at(
+            "c",
+            Vec3::new(0.0, 8.0, 22.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            0.8,
+            512,
+            512,
+        )
+        .unwrap(),
+    );
     b.build().unwrap()
 }
 

@@ -8,7 +8,7 @@ pub enum SceneError {
     #[error("malformed glTF {path}: {message}")]
     Gltf { path: String, message: String },
     /// A pbrt scene file: where and what. `line` 0 means the file as a whole.
-    #[error("{path}:{line}: {message}")]
+    #[error("{path}{}: {message}", line_suffix(*line))]
     Pbrt {
         path: String,
         line: usize,
@@ -26,6 +26,13 @@ pub enum SceneError {
     BadEmission { what: String, value: String },
     #[error("invalid light `{what}`: {message}")]
     BadLight { what: String, message: String },
+    /// A camera a scene made (a built-in's, or the default framing one) that cannot image
+    /// anything; the readers of files report theirs with the file instead.
+    #[error("scene `{scene}`: {error}")]
+    BadCamera {
+        scene: String,
+        error: crate::camera::CameraError,
+    },
     #[error("camera `{0}` not found in the scene")]
     CameraNotFound(String),
     /// `suggestion`: empty, or "; did you mean `x`?" ([`crate::suggest::did_you_mean`]).
@@ -41,4 +48,13 @@ pub enum SceneError {
         key: String,
         message: String,
     },
+}
+
+/// `:line` after a file name, nothing for line 0 (the file as a whole).
+fn line_suffix(line: usize) -> String {
+    if line == 0 {
+        String::new()
+    } else {
+        format!(":{line}")
+    }
 }

@@ -172,11 +172,15 @@ impl Scene {
                 .find(|c| c.name == n)
                 .cloned()
                 .ok_or_else(|| SceneError::CameraNotFound(n.into())),
-            None => Ok(self
-                .cameras
-                .first()
-                .cloned()
-                .unwrap_or_else(|| Camera::framing(self.bounds.0, self.bounds.1, 512, 512))),
+            None => match self.cameras.first() {
+                Some(c) => Ok(c.clone()),
+                None => Camera::framing(self.bounds.0, self.bounds.1, 512, 512).map_err(|error| {
+                    SceneError::BadCamera {
+                        scene: self.name.clone(),
+                        error,
+                    }
+                }),
+            },
         }
     }
 }

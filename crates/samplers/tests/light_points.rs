@@ -64,15 +64,18 @@ fn panel(points: LightPoints) -> Scene {
         wall,
     );
     common::ceiling_square(&mut b, 1.6, 0.5, 3.0);
-    b.add_camera(Camera::look_at(
-        "cam",
-        v(0.0, -2.2, 1.6),
-        v(0.0, 0.2, 0.0),
-        Vec3::Z,
-        50f32.to_radians(),
-        40,
-        30,
-    ));
+    b.add_camera(
+        Camera::look_at(
+            "cam",
+            v(0.0, -2.2, 1.6),
+            v(0.0, 0.2, 0.0),
+            Vec3::Z,
+            50f32.to_radians(),
+            40,
+            30,
+        )
+        .unwrap(),
+    );
     let mut scene = b.build().unwrap();
     scene.light_points = points;
     scene

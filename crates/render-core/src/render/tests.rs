@@ -114,15 +114,18 @@ fn test_scene() -> Scene {
         b.add_sphere_light(centre, 0.02, Vec3::splat(50.0 + i as f32), None)
             .unwrap();
     }
-    b.add_camera(Camera::look_at(
-        "top",
-        Vec3::new(0.0, 5.0, 7.0),
-        Vec3::ZERO,
-        Vec3::Y,
-        0.7,
-        64,
-        40,
-    ));
+    b.add_camera(
+        Camera::look_at(
+            "top",
+            Vec3::new(0.0, 5.0, 7.0),
+            Vec3::ZERO,
+            Vec3::Y,
+            0.7,
+            64,
+            40,
+        )
+        .unwrap(),
+    );
     b.build().unwrap()
 }
 

@@ -190,15 +190,18 @@ pub fn mixed_scene_builder(n_spheres: usize) -> SceneBuilder {
         b.add_sphere_light(c, 0.01 + 0.02 * (i % 4) as f32, l, None)
             .unwrap();
     }
-    b.add_camera(Camera::look_at(
-        "cam",
-        Vec3::new(0.0, 1.4, 2.6),
-        Vec3::new(0.0, 0.2, 0.0),
-        Vec3::Y,
-        50f32.to_radians(),
-        48,
-        36,
-    ));
+    b.add_camera(
+        Camera::look_at(
+            "cam",
+            Vec3::new(0.0, 1.4, 2.6),
+            Vec3::new(0.0, 0.2, 0.0),
+            Vec3::Y,
+            50f32.to_radians(),
+            48,
+            36,
+        )
+        .unwrap(),
+    );
     b
 }
 

@@ -99,7 +99,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         )
         .add_to(&mut b, "panel", panel)?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(5.5, 2.0, 6.5),
         Vec3::new(0.0, 0.75, 0.0),
@@ -107,6 +107,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         40f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }

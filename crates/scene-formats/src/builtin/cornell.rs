@@ -185,7 +185,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
             + Vec3::Y * uniform(&mut rng, -0.45, 0.45) * CELL;
         b.add_sphere_light(cell.center + jitter, radius, cell.radiance * scale, None)?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.0, 1.0, 6.8),
         Vec3::new(0.0, 1.0, 0.0),
@@ -193,6 +193,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         19.5f32.to_radians(),
         256,
         256,
-    ));
+    ))?);
     Ok(b)
 }

@@ -76,7 +76,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
     for (k, m) in lamps.iter().enumerate() {
         m.add_to(&mut b, &format!("lamps {k}"), mats[k])?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.0, 2.0, 9.0),
         Vec3::new(0.0, 0.8, 0.0),
@@ -84,6 +84,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         45f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }

@@ -96,7 +96,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
     for (k, m) in spheres.iter().enumerate() {
         m.add_to(&mut b, &format!("emissive icospheres {k}"), mats[k])?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.0, 1.6, 5.5),
         Vec3::new(0.0, 0.7, -1.0),
@@ -104,6 +104,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         45f32.to_radians(),
         256,
         256,
-    ));
+    ))?);
     Ok(b)
 }

@@ -102,7 +102,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
             m.add_to(&mut b, &format!("emissive triangles {k}"), mats[k])?;
         }
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.0, 1.2, 5.0),
         Vec3::new(0.0, 0.9, 0.0),
@@ -110,7 +110,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         45f32.to_radians(),
         256,
         256,
-    ));
+    ))?);
     Ok(b)
 }
 

@@ -75,7 +75,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         let color = light_color(&mut rng);
         b.add_sphere_light(c, radius, color * l, None)?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.0, 2.2, 8.0),
         Vec3::new(0.0, 0.5, -1.0),
@@ -83,6 +83,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         40f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }

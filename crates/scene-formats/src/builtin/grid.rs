@@ -54,7 +54,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         );
         b.add_sphere_light(c, radius, light_color(&mut rng) * l, None)?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.0, 1.3, 6.5),
         Vec3::new(0.0, 0.3, 0.0),
@@ -62,6 +62,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         40f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }

@@ -127,7 +127,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
             None,
         )?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.0, 2.1, 5.2),
         Vec3::new(0.0, 1.75, 0.0),
@@ -135,6 +135,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         50f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }

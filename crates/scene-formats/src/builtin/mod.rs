@@ -438,6 +438,17 @@ impl Params {
     pub fn builder(&self) -> SceneBuilder {
         SceneBuilder::new(&self.canonical())
     }
+
+    /// The scene's camera, or the error naming this scene where the camera is degenerate.
+    pub fn camera(
+        &self,
+        camera: Result<render_core::camera::Camera, render_core::camera::CameraError>,
+    ) -> Result<render_core::camera::Camera, SceneError> {
+        camera.map_err(|error| SceneError::BadCamera {
+            scene: self.canonical(),
+            error,
+        })
+    }
 }
 
 /// Light colours of luminance 1: warm and cool whites and a few tints.

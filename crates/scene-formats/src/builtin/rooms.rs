@@ -210,7 +210,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         }
     }
 
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         eye,
         target,
@@ -218,7 +218,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         60f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }
 

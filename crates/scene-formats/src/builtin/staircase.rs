@@ -111,7 +111,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         };
         b.add_sphere_light(c, radius, warm * l, None)?;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         Vec3::new(0.5, 1.4, 4.2),
         Vec3::new(0.0, 1.1, -1.6),
@@ -119,6 +119,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         50f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }

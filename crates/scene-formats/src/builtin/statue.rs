@@ -69,7 +69,7 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         b.add_sphere_light(c, radius, light_color(&mut rng) * l, None)?;
         placed += 1;
     }
-    b.add_camera(Camera::look_at(
+    b.add_camera(p.camera(Camera::look_at(
         "main",
         EYE,
         Vec3::new(0.0, 1.5, 0.0),
@@ -77,6 +77,6 @@ pub fn build(p: &Params) -> Result<SceneBuilder, SceneError> {
         40f32.to_radians(),
         320,
         240,
-    ));
+    ))?);
     Ok(b)
 }

@@ -3,7 +3,6 @@ use super::{DEFAULT_CAMERA_HEIGHT, Loader};
 use glam::{Mat4, Vec3};
 use render_core::camera::Camera;
 use render_core::error::SceneError;
-use std::f32::consts::PI;
 
 impl Loader<'_> {
     /// Adds the node's camera (named for the camera, else the node).
@@ -24,9 +23,6 @@ impl Loader<'_> {
             return Ok(());
         };
         let yfov = p.yfov();
-        if !(yfov > 0.0 && yfov < PI) {
-            return Err(self.err(format!("camera `{name}`: yfov {yfov} is not in (0, π)")));
-        }
         let aspect = p
             .aspect_ratio()
             .filter(|a| a.is_finite() && *a > 0.0)
@@ -36,18 +32,9 @@ impl Loader<'_> {
         let eye = world.transform_point3(Vec3::ZERO);
         let forward = world.transform_vector3(Vec3::NEG_Z).normalize_or_zero();
         let up = world.transform_vector3(Vec3::Y).normalize_or_zero();
-        if !eye.is_finite() || forward == Vec3::ZERO || forward.cross(up).length_squared() < 1e-12 {
-            return Err(self.err(format!("camera `{name}`: degenerate node transform")));
-        }
-        self.builder.add_camera(Camera::look_at(
-            &name,
-            eye,
-            eye + forward,
-            up,
-            yfov,
-            width,
-            height,
-        ));
+        let camera = Camera::look_at(&name, eye, eye + forward, up, yfov, width, height)
+            .map_err(|e| self.err(e.to_string()))?;
+        self.builder.add_camera(camera);
         self.report.cameras += 1;
         Ok(())
     }

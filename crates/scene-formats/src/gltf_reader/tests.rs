@@ -367,6 +367,17 @@ fn bad_input_gives_a_clear_error() {
         matches!(e, SceneError::Gltf { .. }) && e.to_string().contains("yfov"),
         "{e}"
     );
+    // a camera node that collapses the view direction
+    let (mut doc, bin) = triangle_doc(TRI);
+    doc["cameras"] =
+        json!([{ "type": "perspective", "perspective": { "yfov": 0.5, "znear": 0.01 } }]);
+    doc["nodes"] = json!([{ "mesh": 0 }, { "camera": 0, "scale": [1.0, 1.0, 0.0] }]);
+    doc["scenes"] = json!([{ "nodes": [0, 1] }]);
+    let e = err(load_gltf(&write_gltf(&tmp, "flat.gltf", doc, &bin), None)).to_string();
+    assert!(
+        e.contains("flat.gltf") && e.contains("camera `camera 0`"),
+        "{e}"
+    );
 
     let empty = write_gltf(
         &tmp,

@@ -5,7 +5,7 @@ use super::Parser;
 use super::records::CameraSpec;
 use glam::DMat4;
 use glam::DVec3;
-use render_core::camera::Camera;
+use render_core::camera::{Camera, check_yfov};
 use render_core::error::SceneError;
 
 impl Parser<'_> {
@@ -19,9 +19,9 @@ impl Parser<'_> {
             self.warn(line, format!("Camera \"{ty}\" is not supported: a perspective camera with the same transform is used"));
         }
         let fov = p.float("fov", 90.0).map_err(|m| self.err(line, m))? as f64;
-        if !(fov > 0.0 && fov < 180.0) {
-            return Err(self.err(line, format!("Camera: fov {fov} is not in (0, 180)")));
-        }
+        // Checked here for the line; the camera made at the end checks it again.
+        check_yfov(fov.to_radians() as f32)
+            .map_err(|m| self.err(line, format!("Camera: fov {fov}: {m}")))?;
         if p.float("lensradius", 0.0).map_err(|m| self.err(line, m))? > 0.0 {
             self.warn(line, "Camera: depth of field is not supported (pinhole)");
         }
@@ -30,7 +30,8 @@ impl Parser<'_> {
         self.camera = Some(CameraSpec {
             camera_from_world: self.state.ctm,
             fov_degrees: fov,
-            line: self.here(line),
+            file: self.current_file(),
+            line,
         });
         Ok(())
     }
@@ -55,29 +56,24 @@ impl Parser<'_> {
         let spec = self.camera.take().unwrap_or(CameraSpec {
             camera_from_world: DMat4::IDENTITY,
             fov_degrees: 90.0,
-            line: "default camera".into(),
+            file: self.current_file(),
+            line: 0,
         });
         let w = self.root * spec.camera_from_world.inverse();
         let eye = w.transform_point3(DVec3::ZERO);
         let forward = w.transform_vector3(DVec3::Z);
         let up = w.transform_vector3(DVec3::Y);
         let right = w.transform_vector3(DVec3::X);
-        if !eye.is_finite() || forward.length() < 1e-12 || forward.cross(up).length() < 1e-12 {
-            return Err(SceneError::Pbrt {
-                path: spec.line.clone(),
-                line: 0,
-                message: "the camera transform is degenerate".into(),
-            });
-        }
         let (fl, ul, rl) = (forward.length(), up.length(), right.length());
         let rigid = (fl - ul).abs() < 1e-6 * fl
             && (fl - rl).abs() < 1e-6 * fl
             && forward.dot(up).abs() < 1e-6 * fl * ul
             && forward.dot(right).abs() < 1e-6 * fl * rl;
         if !rigid {
+            let at = format!("{}:{}", spec.file, spec.line);
             self.warnings.push((
                 "the camera transform scales or shears: its rotation is used".into(),
-                spec.line.clone(),
+                at,
                 1,
             ));
         }
@@ -100,7 +96,12 @@ impl Parser<'_> {
             yfov as f32,
             width,
             height,
-        );
+        )
+        .map_err(|e| SceneError::Pbrt {
+            path: spec.file.clone(),
+            line: spec.line,
+            message: format!("the camera transform is degenerate: {e}"),
+        })?;
         camera.mirrored = mirrored;
         self.builder.add_camera(camera);
         Ok(())

@@ -18,10 +18,14 @@ impl Parser<'_> {
 
     // ---- errors, warnings and positions -------------------------------------------------
 
+    /// The current file, as messages show it.
+    pub(super) fn current_file(&self) -> String {
+        self.sources.last().map_or("?", |s| s.shown.as_str()).into()
+    }
+
     /// `file:line` of the current file.
     pub(super) fn here(&self, line: usize) -> String {
-        let file = self.sources.last().map_or("?", |s| s.shown.as_str());
-        format!("{file}:{line}")
+        format!("{}:{line}", self.current_file())
     }
 
     /// An error at `line` of the current file.

@@ -54,5 +54,8 @@ pub(super) enum Block {
 pub(super) struct CameraSpec {
     pub(super) camera_from_world: DMat4,
     pub(super) fov_degrees: f64,
-    pub(super) line: String,
+    /// The file of the `Camera` directive (as messages show it) and its line; line 0 for the
+    /// default camera.
+    pub(super) file: String,
+    pub(super) line: usize,
 }

@@ -216,7 +216,7 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
         })?;
     }
     if let Some(c) = &comp.camera {
-        b.add_camera(Camera::look_at(
+        let camera = Camera::look_at(
             "main",
             Vec3::from(c.eye),
             Vec3::from(c.target),
@@ -224,7 +224,9 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
             c.yfov_deg.to_radians(),
             c.width,
             c.height,
-        ));
+        )
+        .map_err(|e| bad(path, format!("[camera]: {e}")))?;
+        b.add_camera(camera);
     }
     b.build()
 }
@@ -373,84 +375,4 @@ fn add_lights(b: &mut SceneBuilder, l: &LightLayout) -> Result<(), SceneError> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::scratch::Scratch;
-
-    fn write(tmp: &Scratch, name: &str, text: &str) -> std::path::PathBuf {
-        let p = tmp.path(name);
-        std::fs::write(&p, text).unwrap();
-        p
-    }
-
-    #[test]
-    fn layouts_carry_their_power() {
-        let tmp = Scratch::new("composition");
-        let p = write(
-            &tmp,
-            "studio.toml",
-            r#"
-            [ground]
-            size = 10.0
-            [[lights]]
-            layout = "grid"
-            shape = "sphere"
-            count = 100
-            center = [0.0, 3.0, 0.0]
-            extent = [5.0, 0.0, 5.0]
-            size = 0.01
-            power = 500.0
-            [[lights]]
-            layout = "ring"
-            shape = "quad"
-            count = 10
-            center = [0.0, 2.0, 0.0]
-            extent = [3.0, 0.0, 0.0]
-            size = 0.05
-            power = 100.0
-            [camera]
-            eye = [0.0, 3.0, 8.0]
-            target = [0.0, 0.0, 0.0]
-            "#,
-        );
-        let s = load_composition(&p).unwrap();
-        assert_eq!(s.stats.sphere_lights, 100);
-        assert_eq!(s.stats.triangle_lights, 20);
-        assert!(
-            (s.stats.total_power_w - 600.0).abs() < 0.5,
-            "{}",
-            s.stats.total_power_w
-        );
-        assert_eq!(s.cameras.len(), 1);
-    }
-
-    #[test]
-    fn bad_files_name_the_problem() {
-        let tmp = Scratch::new("composition");
-        let p = write(&tmp, "bad.toml", "[[lights]]\nlayout = \"spiral\"\n");
-        let e = load_composition(&p).err().expect("must fail").to_string();
-        assert!(e.contains("bad.toml") && e.contains("spiral"), "{e}");
-        let p = write(
-            &tmp,
-            "missing.toml",
-            "[[gltf]]\npath = \"no-such-file.glb\"\n",
-        );
-        let e = load_composition(&p).err().expect("must fail").to_string();
-        assert!(e.contains("no-such-file.glb"), "{e}");
-        let p = write(
-            &tmp,
-            "zero.toml",
-            "[[lights]]\nlayout = \"grid\"\nshape = \"sphere\"\ncount = 0\ncenter = [0.0,0.0,0.0]\nextent = [1.0,0.0,1.0]\nsize = 0.1\npower = 1.0\n",
-        );
-        let e = load_composition(&p).err().expect("must fail").to_string();
-        assert!(e.contains("lights[0]"), "{e}");
-        // a count beyond any machine is refused at once (scene-fuzz found it loading for minutes)
-        let p = write(
-            &tmp,
-            "huge.toml",
-            "[[lights]]\nlayout = \"random\"\nshape = \"quad\"\ncount = 9223372036854775807\ncenter = [0.0,0.0,0.0]\nextent = [1.0,0.0,1.0]\nsize = 0.1\npower = 1.0\n",
-        );
-        let e = load_composition(&p).err().expect("must fail").to_string();
-        assert!(e.contains("more than the 4194304 lights"), "{e}");
-    }
-}
+mod tests;

@@ -1,0 +1,142 @@
+//! Composition files: what loads, and what is refused with the file named.
+use super::*;
+use crate::scratch::Scratch;
+
+fn write(tmp: &Scratch, name: &str, text: &str) -> std::path::PathBuf {
+    let p = tmp.path(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+#[test]
+fn layouts_carry_their_power() {
+    let tmp = Scratch::new("composition");
+    let p = write(
+        &tmp,
+        "studio.toml",
+        r#"
+        [ground]
+        size = 10.0
+        [[lights]]
+        layout = "grid"
+        shape = "sphere"
+        count = 100
+        center = [0.0, 3.0, 0.0]
+        extent = [5.0, 0.0, 5.0]
+        size = 0.01
+        power = 500.0
+        [[lights]]
+        layout = "ring"
+        shape = "quad"
+        count = 10
+        center = [0.0, 2.0, 0.0]
+        extent = [3.0, 0.0, 0.0]
+        size = 0.05
+        power = 100.0
+        [camera]
+        eye = [0.0, 3.0, 8.0]
+        target = [0.0, 0.0, 0.0]
+        "#,
+    );
+    let s = load_composition(&p).unwrap();
+    assert_eq!(s.stats.sphere_lights, 100);
+    assert_eq!(s.stats.triangle_lights, 20);
+    assert!(
+        (s.stats.total_power_w - 600.0).abs() < 0.5,
+        "{}",
+        s.stats.total_power_w
+    );
+    assert_eq!(s.cameras.len(), 1);
+}
+
+#[test]
+fn bad_files_name_the_problem() {
+    let tmp = Scratch::new("composition");
+    let p = write(&tmp, "bad.toml", "[[lights]]\nlayout = \"spiral\"\n");
+    let e = load_composition(&p).err().expect("must fail").to_string();
+    assert!(e.contains("bad.toml") && e.contains("spiral"), "{e}");
+    let p = write(
+        &tmp,
+        "missing.toml",
+        "[[gltf]]\npath = \"no-such-file.glb\"\n",
+    );
+    let e = load_composition(&p).err().expect("must fail").to_string();
+    assert!(e.contains("no-such-file.glb"), "{e}");
+    let p = write(
+        &tmp,
+        "zero.toml",
+        "[[lights]]\nlayout = \"grid\"\nshape = \"sphere\"\ncount = 0\ncenter = [0.0,0.0,0.0]\nextent = [1.0,0.0,1.0]\nsize = 0.1\npower = 1.0\n",
+    );
+    let e = load_composition(&p).err().expect("must fail").to_string();
+    assert!(e.contains("lights[0]"), "{e}");
+    // a count beyond any machine is refused at once (scene-fuzz found it loading for minutes)
+    let p = write(
+        &tmp,
+        "huge.toml",
+        "[[lights]]\nlayout = \"random\"\nshape = \"quad\"\ncount = 9223372036854775807\ncenter = [0.0,0.0,0.0]\nextent = [1.0,0.0,1.0]\nsize = 0.1\npower = 1.0\n",
+    );
+    let e = load_composition(&p).err().expect("must fail").to_string();
+    assert!(e.contains("more than the 4194304 lights"), "{e}");
+}
+
+/// A studio of one light over a ground, with `camera` as its `[camera]` table.
+fn studio(camera: &str) -> String {
+    format!(
+        "[ground]\nsize = 10.0\n[[lights]]\nlayout = \"grid\"\nshape = \"sphere\"\ncount = 1\n\
+         center = [0.0, 3.0, 0.0]\nextent = [1.0, 0.0, 1.0]\nsize = 0.1\npower = 10.0\n\
+         [camera]\n{camera}\n"
+    )
+}
+
+/// A camera that sees nothing is an error naming the file and the camera (each rendered
+/// black, or not at all, with exit status 0).
+#[test]
+fn degenerate_cameras_are_refused() {
+    let tmp = Scratch::new("composition");
+    let ok = write(
+        &tmp,
+        "ok.toml",
+        &studio("eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]"),
+    );
+    assert_eq!(load_composition(&ok).unwrap().cameras.len(), 1);
+    let cases = [
+        (
+            "eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 1.0, 5.0]",
+            "the same point",
+        ),
+        (
+            "eye = [0.0, 5.0, 0.0]\ntarget = [0.0, 0.0, 0.0]",
+            "parallel to the view direction",
+        ),
+        (
+            "eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nyfov_deg = 0.0",
+            "yfov 0°",
+        ),
+        (
+            "eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nyfov_deg = 180.0",
+            "yfov 180°",
+        ),
+        (
+            "eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nyfov_deg = nan",
+            "yfov NaN°",
+        ),
+        (
+            "eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, inf]",
+            "must be finite",
+        ),
+        (
+            "eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = 0",
+            "0 × 240",
+        ),
+    ];
+    for (k, (camera, want)) in cases.iter().enumerate() {
+        let p = write(&tmp, &format!("cam{k}.toml"), &studio(camera));
+        let e = load_composition(&p).err().expect("must fail").to_string();
+        assert!(
+            e.contains(&format!("cam{k}.toml: [camera]: camera `main`: "))
+                && e.contains(want)
+                && !e.contains('\n'),
+            "case {k}: {e}"
+        );
+    }
+}
