@@ -25,6 +25,8 @@
 //! eye = [6.0, 3.0, 8.0]
 //! target = [0.0, 0.8, 0.0]
 //! ```
+mod checks;
+
 use crate::builtin::mesh::Mesh;
 use crate::gltf_reader::add_gltf;
 use glam::{Mat4, Vec3};
@@ -195,6 +197,7 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
             .collect();
         bad(path, parts.join(": "))
     })?;
+    checks::check(&comp).map_err(|m| bad(path, m))?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut b = SceneBuilder::new(comp.name.as_deref().unwrap_or(&path.display().to_string()));
     for part in &comp.gltf {
@@ -303,9 +306,14 @@ fn add_lights(b: &mut SceneBuilder, l: &LightLayout) -> Result<(), SceneError> {
         what: "layout".into(),
         message: m,
     };
-    if l.count == 0 || !(l.size > 0.0) || !(l.power > 0.0) || !l.power.is_finite() {
+    if l.count == 0
+        || !(l.size > 0.0)
+        || !l.size.is_finite()
+        || !(l.power > 0.0)
+        || !l.power.is_finite()
+    {
         return Err(err(format!(
-            "count {}, size {}, power {} must be positive",
+            "count {}, size {}, power {} must be positive (and size and power finite)",
             l.count, l.size, l.power
         )));
     }

@@ -1,4 +1,4 @@
-//! Composition files: what loads, and what is refused with the file named.
+//! Composition files: what loads, and what is refused with the file and field named.
 use super::*;
 use crate::scratch::Scratch;
 
@@ -137,6 +137,98 @@ fn degenerate_cameras_are_refused() {
                 && e.contains(want)
                 && !e.contains('\n'),
             "case {k}: {e}"
+        );
+    }
+}
+
+/// Each number out of its range is an error naming the file and the field: a `fit_size` of 0
+/// collapsed the asset to a point (every triangle skipped as degenerate), a roughness of 5
+/// was used as it was.
+#[test]
+fn numbers_out_of_range_name_their_field() {
+    let tmp = Scratch::new("composition");
+    let asset = write(
+        &tmp,
+        "asset.pbrt",
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n",
+    );
+    let part = |fields: &str| {
+        format!(
+            "[[gltf]]\npath = \"{}\"\n{fields}\n{}",
+            asset.file_name().unwrap().to_string_lossy(),
+            studio("eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]")
+        )
+    };
+    let ok = write(&tmp, "ok.toml", &part("fit_size = 2.0"));
+    assert_eq!(load_composition(&ok).unwrap().triangles.len(), 3);
+    let cases = [
+        (
+            part("fit_size = 0.0"),
+            "gltf[0].fit_size 0 must be positive and finite",
+        ),
+        (
+            part("fit_size = -1.0"),
+            "gltf[0].fit_size -1 must be positive",
+        ),
+        (
+            part("fit_size = inf"),
+            "gltf[0].fit_size inf must be positive and finite",
+        ),
+        (part("scale = 0.0"), "gltf[0].scale 0 must be positive"),
+        (
+            part("translate = [0.0, nan, 0.0]"),
+            "gltf[0].translate [0.0, NaN, 0.0] must be finite",
+        ),
+        (
+            part("rotate_y_deg = inf"),
+            "gltf[0].rotate_y_deg inf must be finite",
+        ),
+        (
+            part("[[gltf.override]]\nroughness = 5.0"),
+            "gltf[0].override[0].roughness 5 must be in [0, 1]",
+        ),
+        (
+            part("[[gltf.override]]\nmetallic = -0.5"),
+            "gltf[0].override[0].metallic -0.5 must be in [0, 1]",
+        ),
+        (
+            part("[[gltf.override]]\nbase_color = [5.0, 5.0, 5.0]"),
+            "gltf[0].override[0].base_color [5.0, 5.0, 5.0] must be in [0, 1]",
+        ),
+        (
+            "[ground]\nsize = 0.0\n".into(),
+            "ground.size 0 must be positive and finite",
+        ),
+        (
+            "[ground]\nsize = 10.0\nroughness = 2.0\n".into(),
+            "ground.roughness 2 must be in [0, 1]",
+        ),
+        (
+            studio("eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]\nwidth = 100000"),
+            "camera: image size 100000 × 240 is larger than 65536 × 65536",
+        ),
+        (
+            studio("eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]")
+                .replace("size = 0.1", "size = inf"),
+            "lights[0]: count 1, size inf, power 10 must be positive (and size and power finite)",
+        ),
+        (
+            studio("eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]")
+                .replace("center = [0.0, 3.0, 0.0]", "center = [0.0, inf, 0.0]"),
+            "lights[0].center [0.0, inf, 0.0] must be finite",
+        ),
+        (
+            studio("eye = [0.0, 1.0, 5.0]\ntarget = [0.0, 0.0, 0.0]")
+                .replace("power = 10.0", "power = 10.0\ncolor = [0.0, 0.0, 0.0]"),
+            "lights[0].color [0.0, 0.0, 0.0] must be finite and non-negative",
+        ),
+    ];
+    for (k, (text, want)) in cases.iter().enumerate() {
+        let p = write(&tmp, &format!("range{k}.toml"), text);
+        let e = load_composition(&p).err().expect("must fail").to_string();
+        assert!(
+            e.contains(&format!("range{k}.toml: {want}")) && !e.contains('\n'),
+            "case {k}: want `{want}`, got `{e}`"
         );
     }
 }
