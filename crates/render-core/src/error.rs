@@ -24,6 +24,15 @@ pub enum SceneError {
     BadMaterial { name: String, message: String },
     #[error("invalid emission in {what}: {value} (must be finite and non-negative)")]
     BadEmission { what: String, value: String },
+    /// A light whose emitted power (radiance × area, intensity × 4π) overflows f32.
+    #[error(
+        "{what}: emission {emission} over {size} emits an infinite power (it must stay below 3.4e38 W: lower the emission or the size)"
+    )]
+    InfinitePower {
+        what: String,
+        emission: String,
+        size: String,
+    },
     #[error("invalid light `{what}`: {message}")]
     BadLight { what: String, message: String },
     /// A camera a scene made (a built-in's, or the default framing one) that cannot image

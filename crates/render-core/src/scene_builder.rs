@@ -9,6 +9,12 @@ use crate::light::{DistantLight, Light, LightShape, SpotCone, TriangleRecord};
 use crate::material::Material;
 use crate::scene::{NO_LIGHT, Scene, SceneStats, Triangle};
 use glam::{Mat4, Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// A vector as `[x, y, z]` for messages.
+fn fmt3(v: Vec3) -> String {
+    format!("[{}, {}, {}]", v.x, v.y, v.z)
+}
 
 /// Collects geometry, materials and lights, validates them and builds a [`Scene`].
 pub struct SceneBuilder {
@@ -82,6 +88,30 @@ fn check_emission(what: &str, e: Vec3) -> Result<(), SceneError> {
         });
     }
     Ok(())
+}
+
+/// A light's power must be finite, in luminance and in its brightest channel: the strategies
+/// weigh lights by it and a light sample's value is of its size, so an infinite one makes NaN
+/// pixels or a light tree that cannot be built. `what` names the light for the message.
+fn check_power(light: &Light, what: impl FnOnce() -> String) -> Result<(), SceneError> {
+    let factor = match &light.shape {
+        LightShape::Triangle { area, .. } => area * if light.two_sided { 2.0 } else { 1.0 } * PI,
+        LightShape::Sphere { radius, .. } => 4.0 * PI * PI * radius * radius,
+        LightShape::Point { .. } => 4.0 * PI,
+    };
+    let brightest = light.mean_emission.max_element() * factor;
+    if light.power().is_finite() && brightest.is_finite() {
+        return Ok(());
+    }
+    Err(SceneError::InfinitePower {
+        what: what(),
+        emission: format!("{:?}", light.mean_emission.to_array()),
+        size: match &light.shape {
+            LightShape::Triangle { area, .. } => format!("area {area}"),
+            LightShape::Sphere { radius, .. } => format!("radius {radius}"),
+            LightShape::Point { .. } => "a point".into(),
+        },
+    })
 }
 
 /// Mean of an emission texture over a triangle, by a stratified barycentric grid whose
@@ -211,7 +241,7 @@ impl SceneBuilder {
                 };
                 if mean.max_element() > 0.0 {
                     light = self.lights.len() as u32;
-                    self.lights.push(Light {
+                    let l = Light {
                         shape: LightShape::Triangle {
                             p,
                             normal: ng,
@@ -223,7 +253,14 @@ impl SceneBuilder {
                         mean_emission: mean,
                         two_sided: mat.double_sided,
                         spot: None,
-                    });
+                    };
+                    check_power(&l, || {
+                        format!(
+                            "triangle {k} of mesh `{mesh_name}` (emissive material `{}`)",
+                            mat.name
+                        )
+                    })?;
+                    self.lights.push(l);
                     self.stats.triangle_lights += 1;
                 } else {
                     self.stats.black_emissive_triangles += 1;
@@ -255,15 +292,17 @@ impl SceneBuilder {
                 message: format!("center {center:?}, radius {radius}"),
             });
         }
-        self.spheres.push(self.lights.len() as u32);
-        self.lights.push(Light {
+        let l = Light {
             shape: LightShape::Sphere { center, radius },
             emission: radiance,
             texture: None,
             mean_emission: radiance,
             two_sided: false,
             spot,
-        });
+        };
+        check_power(&l, || format!("sphere light at {}", fmt3(center)))?;
+        self.spheres.push(self.lights.len() as u32);
+        self.lights.push(l);
         self.stats.sphere_lights += 1;
         Ok(())
     }
@@ -281,19 +320,21 @@ impl SceneBuilder {
                 message: format!("position {position:?}"),
             });
         }
-        if spot.is_some() {
-            self.stats.spot_lights += 1;
-        } else {
-            self.stats.point_lights += 1;
-        }
-        self.lights.push(Light {
+        let l = Light {
             shape: LightShape::Point { position },
             emission: intensity,
             texture: None,
             mean_emission: intensity,
             two_sided: false,
             spot,
-        });
+        };
+        check_power(&l, || format!("point light at {}", fmt3(position)))?;
+        if spot.is_some() {
+            self.stats.spot_lights += 1;
+        } else {
+            self.stats.point_lights += 1;
+        }
+        self.lights.push(l);
         Ok(())
     }
 
@@ -414,3 +455,7 @@ impl SceneBuilder {
         })
     }
 }
+
+#[cfg(test)]
+#[path = "scene_builder_tests.rs"]
+mod tests;
