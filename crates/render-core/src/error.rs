@@ -42,6 +42,13 @@ pub enum SceneError {
         scene: String,
         error: crate::camera::CameraError,
     },
+    /// A scene file whose name says no format we read.
+    #[error("{path}: unsupported scene {what} (supported: {supported})")]
+    UnsupportedFormat {
+        path: String,
+        what: String,
+        supported: String,
+    },
     #[error("camera `{0}` not found in the scene")]
     CameraNotFound(String),
     /// `suggestion`: empty, or "; did you mean `x`?" ([`crate::suggest::did_you_mean`]).

@@ -236,10 +236,13 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
 
 /// A glTF file, or a pbrt scene (`.pbrt`) placed the same way.
 fn add_asset(b: &mut SceneBuilder, file: &Path, transform: Mat4) -> Result<(), SceneError> {
-    if file.extension().is_some_and(|e| e == "pbrt") {
-        crate::pbrt::add_pbrt(b, file, transform).map(|_| ())
-    } else {
-        add_gltf(b, file, transform).map(|_| ())
+    match crate::FileFormat::of(file)? {
+        crate::FileFormat::Pbrt => crate::pbrt::add_pbrt(b, file, transform).map(|_| ()),
+        crate::FileFormat::Gltf => add_gltf(b, file, transform).map(|_| ()),
+        crate::FileFormat::Composition => Err(bad(
+            file,
+            "a composition cannot place another composition (place a .gltf, .glb or .pbrt)",
+        )),
     }
 }
 

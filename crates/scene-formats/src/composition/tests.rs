@@ -232,3 +232,23 @@ fn numbers_out_of_range_name_their_field() {
         );
     }
 }
+
+/// A placed asset's format follows its extension in any case (`ASSET.PBRT` was read as
+/// glTF); an unknown extension is refused by name.
+#[test]
+fn placed_assets_follow_their_extension_in_any_case() {
+    let tmp = Scratch::new("composition");
+    write(
+        &tmp,
+        "ASSET.PBRT",
+        "Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0]\n",
+    );
+    let upper = write(&tmp, "upper.toml", "[[gltf]]\npath = \"ASSET.PBRT\"\n");
+    assert_eq!(load_composition(&upper).unwrap().triangles.len(), 1);
+    let ply = write(&tmp, "ply.toml", "[[gltf]]\npath = \"bunny.ply\"\n");
+    let e = load_composition(&ply).err().expect("must fail").to_string();
+    assert!(
+        e.contains("bunny.ply: unsupported scene format `.ply` (supported: "),
+        "{e}"
+    );
+}
