@@ -49,6 +49,12 @@ pub enum SceneError {
         what: String,
         supported: String,
     },
+    /// An error of the scene builder (which knows no files), in the file that caused it.
+    #[error("{path}: {error}")]
+    InFile {
+        path: String,
+        error: Box<SceneError>,
+    },
     #[error("camera `{0}` not found in the scene")]
     CameraNotFound(String),
     /// `suggestion`: empty, or "; did you mean `x`?" ([`crate::suggest::did_you_mean`]).
@@ -64,6 +70,33 @@ pub enum SceneError {
         key: String,
         message: String,
     },
+}
+
+impl SceneError {
+    /// The error itself, under any [`SceneError::InFile`] that says where it arose.
+    pub fn cause(&self) -> &SceneError {
+        match self {
+            SceneError::InFile { error, .. } => error.cause(),
+            e => e,
+        }
+    }
+
+    /// `self` as an error of the file `path`, unless it names its file already (the errors
+    /// of the scene builder do not: it knows no files).
+    pub fn in_file(self, path: &std::path::Path) -> SceneError {
+        match self {
+            SceneError::Empty
+            | SceneError::NonFiniteVertex { .. }
+            | SceneError::BadMaterial { .. }
+            | SceneError::BadEmission { .. }
+            | SceneError::BadLight { .. }
+            | SceneError::InfinitePower { .. } => SceneError::InFile {
+                path: path.display().to_string(),
+                error: Box::new(self),
+            },
+            e => e,
+        }
+    }
 }
 
 /// `:line` after a file name, nothing for line 0 (the file as a whole).

@@ -215,7 +215,7 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
     for (k, l) in comp.lights.iter().enumerate() {
         add_lights(&mut b, l).map_err(|e| match e {
             SceneError::BadLight { message, .. } => bad(path, format!("lights[{k}]: {message}")),
-            other => other,
+            other => other.in_file(path),
         })?;
     }
     if let Some(c) = &comp.camera {
@@ -231,7 +231,7 @@ pub fn load_composition(path: &Path) -> Result<Scene, SceneError> {
         .map_err(|e| bad(path, format!("[camera]: {e}")))?;
         b.add_camera(camera);
     }
-    b.build()
+    b.build().map_err(|e| e.in_file(path))
 }
 
 /// A glTF file, or a pbrt scene (`.pbrt`) placed the same way.

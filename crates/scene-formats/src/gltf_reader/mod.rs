@@ -127,7 +127,7 @@ pub fn load_gltf_with_report(
     let report = add_gltf(&mut builder, path, Mat4::IDENTITY)?;
     if report.triangles == 0 {
         if report.punctual_lights() == 0 {
-            return Err(SceneError::Empty);
+            return Err(SceneError::Empty.in_file(path));
         }
         return Err(gltf_err(
             path,
@@ -137,7 +137,7 @@ pub fn load_gltf_with_report(
             ),
         ));
     }
-    let mut scene = builder.build()?;
+    let mut scene = builder.build().map_err(|e| e.in_file(path))?;
     if scene.triangles.is_empty() {
         return Err(gltf_err(
             path,
@@ -204,14 +204,21 @@ pub fn add_gltf(
     // External files are read whole by the gltf crate: each must be a regular file (not
     // /dev/zero, a pipe or a directory), and its URI must decode (the crate panics otherwise).
     let base = path.parent().unwrap_or_else(|| Path::new("."));
-    let uris = (json.buffers.iter().filter_map(|b| b.uri.as_deref()))
-        .chain(json.images.iter().filter_map(|i| i.uri.as_deref()));
-    for uri in uris {
-        // (a missing file is left to the gltf crate, whose message names the buffer)
+    let buffers = json.buffers.iter().map(|b| ("buffers", b.uri.as_deref()));
+    let images = json.images.iter().map(|i| ("images", i.uri.as_deref()));
+    let mut index = HashMap::new();
+    for (kind, uri) in buffers.chain(images) {
+        let k = index.entry(kind).or_insert(0usize);
+        *k += 1;
+        let Some(uri) = uri else { continue };
+        // A missing buffer is named here (the gltf crate's message names neither it nor its
+        // file); a missing image is left to the texture reader, which names it.
         if let Some(file) = external_file(base, uri).map_err(|e| gltf_err(path, e))?
-            && file.exists()
+            && (kind == "buffers" || file.exists())
         {
-            regular_file(&file).map_err(|e| gltf_err(path, format!("{}: {e}", file.display())))?;
+            regular_file(&file).map_err(|e| {
+                gltf_err(path, format!("{kind}[{}]: {}: {e}", *k - 1, file.display()))
+            })?;
         }
     }
     drop(raw);
@@ -236,7 +243,7 @@ pub fn add_gltf(
     let report = std::mem::take(&mut loader.report);
     match result {
         Ok(Ok(())) => Ok(report),
-        Ok(Err(e)) => Err(e),
+        Ok(Err(e)) => Err(e.in_file(path)),
         Err(_) => Err(gltf_err(
             path,
             "the file could not be read (malformed data)",

@@ -302,7 +302,14 @@ fn bad_input_gives_a_clear_error() {
 
     let (doc, bin) = triangle_doc([0.0, 0.0, 0.0, f32::NAN, 0.0, 0.0, 0.0, 1.0, 0.0]);
     let e = err(load_gltf(&write_gltf(&tmp, "nan.gltf", doc, &bin), None));
-    assert!(matches!(e, SceneError::NonFiniteVertex { .. }), "{e}");
+    assert!(
+        matches!(e.cause(), SceneError::NonFiniteVertex { .. }),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("nan.gltf: "),
+        "the file is named: {e}"
+    );
 
     let (mut doc, bin) = triangle_doc(TRI);
     doc["materials"] = json!([{ "name": "bad", "emissiveFactor": [1.0, -1.0, 0.0] }]);
@@ -311,16 +318,22 @@ fn bad_input_gives_a_clear_error() {
         &write_gltf(&tmp, "negative.gltf", doc, &bin),
         None,
     ));
-    assert!(matches!(e, SceneError::BadEmission { .. }), "{e}");
+    assert!(matches!(e.cause(), SceneError::BadEmission { .. }), "{e}");
     assert!(e.to_string().contains("bad"), "{e}");
+    assert!(
+        e.to_string().contains("negative.gltf: "),
+        "the file is named: {e}"
+    );
 
     let (mut doc, bin) = triangle_doc(TRI);
     doc["materials"] = json!([{ "emissiveFactor": [1.0, 1.0, 1.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": -2.0 } } }]);
     doc["meshes"][0]["primitives"][0]["material"] = json!(0);
-    assert!(matches!(
-        load_gltf(&write_gltf(&tmp, "negative2.gltf", doc, &bin), None),
-        Err(SceneError::BadEmission { .. })
+    let e = err(load_gltf(
+        &write_gltf(&tmp, "negative2.gltf", doc, &bin),
+        None,
     ));
+    assert!(matches!(e.cause(), SceneError::BadEmission { .. }), "{e}");
+    assert!(e.to_string().contains("negative2.gltf: "), "{e}");
 
     let (mut doc, bin) = triangle_doc(TRI);
     doc["extensions"] =
@@ -328,10 +341,12 @@ fn bad_input_gives_a_clear_error() {
     doc["nodes"] =
         json!([{ "mesh": 0 }, { "extensions": { "KHR_lights_punctual": { "light": 0 } } }]);
     doc["scenes"] = json!([{ "nodes": [0, 1] }]);
-    assert!(matches!(
-        load_gltf(&write_gltf(&tmp, "negative3.gltf", doc, &bin), None),
-        Err(SceneError::BadEmission { .. })
+    let e = err(load_gltf(
+        &write_gltf(&tmp, "negative3.gltf", doc, &bin),
+        None,
     ));
+    assert!(matches!(e.cause(), SceneError::BadEmission { .. }), "{e}");
+    assert!(e.to_string().contains("negative3.gltf: "), "{e}");
 
     // Non-finite emission (1e39 overflows f32), bad radii, a bad camera.
     let (mut doc, bin) = triangle_doc(TRI);
@@ -341,7 +356,19 @@ fn bad_input_gives_a_clear_error() {
         &write_gltf(&tmp, "infinite.gltf", doc, &bin),
         None,
     ));
-    assert!(matches!(e, SceneError::BadEmission { .. }), "{e}");
+    assert!(matches!(e.cause(), SceneError::BadEmission { .. }), "{e}");
+    assert!(e.to_string().contains("infinite.gltf: "), "{e}");
+    // finite emission, infinite power: 1e38 over the triangle's area (the audit's case)
+    let (mut doc, bin) = triangle_doc(TRI.map(|x| 4.0 * x));
+    doc["materials"] = json!([{ "name": "sun", "emissiveFactor": [1.0, 1.0, 1.0], "extensions": { "KHR_materials_emissive_strength": { "emissiveStrength": 1e38 } } }]);
+    doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let e = err(load_gltf(&write_gltf(&tmp, "sun.gltf", doc, &bin), None));
+    assert!(matches!(e.cause(), SceneError::InfinitePower { .. }), "{e}");
+    assert!(
+        e.to_string().starts_with("sun.gltf: ") || e.to_string().contains("/sun.gltf: "),
+        "{e}"
+    );
+    assert!(e.to_string().contains("material `sun`"), "{e}");
     for (i, extras) in [json!({ "radius": -0.5 }), json!({ "radius": "big" })]
         .into_iter()
         .enumerate()
@@ -355,7 +382,8 @@ fn bad_input_gives_a_clear_error() {
             &write_gltf(&tmp, &format!("radius{i}.gltf"), doc, &bin),
             None,
         ));
-        assert!(matches!(e, SceneError::BadLight { .. }), "{e}");
+        assert!(matches!(e.cause(), SceneError::BadLight { .. }), "{e}");
+        assert!(e.to_string().contains(&format!("radius{i}.gltf: ")), "{e}");
     }
     let (mut doc, bin) = triangle_doc(TRI);
     doc["cameras"] =
@@ -386,7 +414,8 @@ fn bad_input_gives_a_clear_error() {
         &[],
     );
     let e = err(load_gltf(&empty, None));
-    assert!(matches!(e, SceneError::Empty), "{e}");
+    assert!(matches!(e.cause(), SceneError::Empty), "{e}");
+    assert!(e.to_string().contains("empty.gltf: "), "{e}");
 
     let lights_only = json!({
         "asset": { "version": "2.0" },
@@ -664,5 +693,9 @@ fn external_buffers_and_texture_transforms() {
     assert!(
         matches!(e, SceneError::Gltf { .. }) && e.to_string().contains("buffers"),
         "{e}"
+    );
+    assert!(
+        e.to_string().contains("buffers[0]: ") && e.to_string().contains("external.bin: "),
+        "the missing file is named: {e}"
     );
 }
