@@ -99,6 +99,26 @@ impl PropertyAccess for Element {
     }
 }
 
+/// The PLY reader's message on one line. It nests its errors ("Couldn't read element line.
+/// String: '…' Error: Couldn't parse element line. String: '…' Error: error at 1:1: expected
+/// one of …"), each part on lines of its own and the quoted line with its newline: kept are
+/// the outer part and the innermost error, without the grammar's list of the characters it
+/// expected, whitespace collapsed.
+fn one_line(e: &impl std::fmt::Display) -> String {
+    let text = e.to_string().replace("\r\n'", "'").replace("\n'", "'");
+    let text = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    let text = match text.find(": expected one of") {
+        Some(i) => &text[..i],
+        None => &text,
+    };
+    match (text.find(" Error: "), text.rfind(" Error: ")) {
+        (Some(first), Some(last)) if first != last => {
+            format!("{}{}", &text[..first], &text[last..])
+        }
+        _ => text.to_string(),
+    }
+}
+
 /// Reads a PLY file into an object-space mesh.
 pub fn read(path: &Path) -> Result<MeshData, String> {
     let file =
@@ -107,7 +127,7 @@ pub fn read(path: &Path) -> Result<MeshData, String> {
     let parser = Parser::<Element>::new();
     let header = parser
         .read_header(&mut reader)
-        .map_err(|e| format!("{}: malformed PLY header: {e}", path.display()))?;
+        .map_err(|e| format!("{}: malformed PLY header: {}", path.display(), one_line(&e)))?;
     let mut mesh = MeshData::default();
     let mut normals = Vec::new();
     let mut uvs = Vec::new();
@@ -115,7 +135,10 @@ pub fn read(path: &Path) -> Result<MeshData, String> {
     for (name, def) in &header.elements {
         let elements = parser
             .read_payload_for_element(&mut reader, def, &header)
-            .map_err(|e| format!("{}: malformed PLY element `{name}`: {e}", path.display()))?;
+            .map_err(|e| {
+                let e = one_line(&e);
+                format!("{}: malformed PLY element `{name}`: {e}", path.display())
+            })?;
         match name.as_str() {
             "vertex" => {
                 mesh.positions.reserve(elements.len());

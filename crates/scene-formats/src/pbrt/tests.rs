@@ -437,6 +437,10 @@ fn convert_round_trips_through_gltf() {
     assert!(scene.render_hints.filter.is_some());
 }
 
+/// The start of a PLY file, and its elements: three vertices (x, y, z) and one face.
+const PLY_HEADER: &str = "ply\n";
+const PLY_ELEMENTS: &str = "element vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
 fn error_of(files: &[(&str, &str)]) -> String {
     let d = dir(&format!("err-{}", files[0].1.len() + files.len()));
     for (name, text) in files {
@@ -470,6 +474,8 @@ fn malformed_input_is_one_error_with_file_and_line() {
         (vec![("p.pbrt", format!("Camera \"perspective\" \"float fov\" 0\n{shape}"))], "p.pbrt:1: Camera: fov 0: yfov 0° is not in (0°, 180°)"),
         (vec![("q.pbrt", format!("Scale 1 0 1\nCamera \"perspective\"\n{shape}"))], "q.pbrt:2: the camera transform is degenerate: camera `pbrt camera`: "),
         (vec![("r.pbrt", format!("Include \"s.pbrt\"\n{shape}")), ("s.pbrt", "\nScale 0 0 0\nCamera \"perspective\"\n".into())], "s.pbrt:3: the camera transform is degenerate"),
+        (vec![("t.pbrt", "Shape \"plymesh\" \"string filename\" \"nan.ply\"\n".into()), ("nan.ply", format!("{PLY_HEADER}format ascii 1.0\n{PLY_ELEMENTS}nan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"))], "nan.ply: malformed PLY element `vertex`: Line 10: Couldn't read element line. String: 'nan 0 0' Error: error at 1:1"),
+        (vec![("u.pbrt", "\nShape \"plymesh\" \"string filename\" \"cut.ply\"\n".into()), ("cut.ply", format!("{PLY_HEADER}format binary_little_endian 1.0\n{PLY_ELEMENTS}abcd"))], "cut.ply: malformed PLY element `vertex`: Line 10: Unexpected end of file while reading binary element 'vertex' (expected 3, got 0)."),
     ];
     for (files, want) in &cases {
         let files: Vec<(&str, &str)> = files.iter().map(|(n, t)| (*n, t.as_str())).collect();
