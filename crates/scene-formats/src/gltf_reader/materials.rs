@@ -57,7 +57,10 @@ impl Loader<'_> {
                     .emissive_texture()
                     .map(|t| self.texture(&t.texture(), true))
                     .transpose()?;
-                let bc = pbr.base_color_factor();
+                let bc = self.unit_factor(&name, "baseColorFactor", &pbr.base_color_factor()[..3]);
+                let metallic = self.unit_factor(&name, "metallicFactor", &[pbr.metallic_factor()]);
+                let roughness =
+                    self.unit_factor(&name, "roughnessFactor", &[pbr.roughness_factor()]);
                 let strength = m.emissive_strength().unwrap_or(1.0);
                 let emission = Vec3::from(m.emissive_factor()) * strength;
                 if !emission.is_finite() || emission.min_element() < 0.0 {
@@ -90,13 +93,13 @@ impl Loader<'_> {
                         "material `{name}`: specular texture and colour ignored (factor used)"
                     ));
                 }
-                let model = self.transmission_model(&m, &name)?;
+                let model = self.transmission_model(&m, &name, roughness[0])?;
                 let gltf_material = Material {
                     name,
-                    base_color: Vec3::new(bc[0], bc[1], bc[2]),
+                    base_color: Vec3::from_slice(&bc),
                     base_color_texture,
-                    metallic: pbr.metallic_factor(),
-                    roughness: pbr.roughness_factor(),
+                    metallic: metallic[0],
+                    roughness: roughness[0],
                     metallic_roughness_texture,
                     specular: specular.map_or(1.0, |s| s.specular_factor()),
                     double_sided: m.double_sided(),
@@ -118,11 +121,29 @@ impl Loader<'_> {
         Ok((id, uv))
     }
 
+    /// A factor glTF 2.0 limits to [0, 1], clamped there, with a warning naming the file and
+    /// the material where it was not.
+    fn unit_factor(&mut self, material: &str, field: &str, values: &[f32]) -> Vec<f32> {
+        let clamped: Vec<f32> = values.iter().map(|v| v.clamp(0.0, 1.0)).collect();
+        if clamped.as_slice() != values {
+            self.report.warn(format!(
+                "{}: material `{material}`: {field} {values:?} is outside [0, 1] (glTF 2.0's range): {clamped:?} used",
+                self.path.display()
+            ));
+        }
+        clamped
+    }
+
     /// `KHR_materials_transmission` with a factor above 0 makes the rough dielectric: ior from
     /// `KHR_materials_ior` (1.5 by default), α = roughness², the base colour as the tint. A
     /// partial factor, a transmission texture, metalness and `KHR_materials_volume` (a thick
     /// medium) are not modelled: a warning each, and the surface is one thin interface.
-    fn transmission_model(&mut self, m: &gltf::Material, name: &str) -> Result<Model, SceneError> {
+    fn transmission_model(
+        &mut self,
+        m: &gltf::Material,
+        name: &str,
+        roughness: f32,
+    ) -> Result<Model, SceneError> {
         let volume = m.extension_value("KHR_materials_volume").is_some();
         let Some(t) = m.transmission().filter(|t| t.transmission_factor() > 0.0) else {
             if volume {
@@ -160,7 +181,7 @@ impl Loader<'_> {
             name: name.into(),
             message,
         })?;
-        let r = pbr.roughness_factor();
+        let r = roughness;
         Ok(Model::Dielectric {
             ior,
             alpha: (r * r).clamp(MIN_ALPHA, 1.0),

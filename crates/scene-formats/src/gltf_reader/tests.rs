@@ -699,3 +699,28 @@ fn external_buffers_and_texture_transforms() {
         "the missing file is named: {e}"
     );
 }
+
+/// Factors glTF 2.0 limits to [0, 1] are clamped there, with a warning naming the file and the
+/// material (a base colour of 5 was used as given, a negative roughness refused).
+#[test]
+fn factors_beyond_their_range_are_clamped_with_a_warning() {
+    let tmp = Scratch::new("gltf-clamp");
+    let (mut doc, bin) = triangle_doc(TRI);
+    doc["materials"] = json!([{ "name": "hot", "pbrMetallicRoughness": {
+        "baseColorFactor": [5.0, 0.5, -1.0, 1.0], "metallicFactor": 2.0, "roughnessFactor": -1.0 } }]);
+    doc["meshes"][0]["primitives"][0]["material"] = json!(0);
+    let path = write_gltf(&tmp, "hot.gltf", doc, &bin);
+    let (scene, report) = load_gltf_with_report(&path, None).unwrap();
+    let m = &scene.materials[0];
+    assert_eq!(
+        (m.base_color, m.metallic, m.roughness),
+        (Vec3::new(1.0, 0.5, 0.0), 1.0, 0.0)
+    );
+    let warnings: Vec<&String> = report
+        .warnings
+        .iter()
+        .filter(|w| w.contains("hot.gltf: material `hot`: ") && w.contains("outside [0, 1]"))
+        .collect();
+    assert_eq!(warnings.len(), 3, "{:?}", report.warnings);
+    assert_eq!(scene.stats.warnings.len(), report.warnings.len());
+}

@@ -192,7 +192,7 @@ pub fn material(
                 ctx.warnings
                     .push("matte `sigma` (Oren–Nayar) read as Lambert".into());
             }
-            Material::diffuse(name, kd)
+            Material::diffuse(name, diffuse_reflectance(name, kind, kd, ctx))
         }
         "plastic" => {
             let kd = ctx.colour(p, "Kd", Vec3::splat(plastic::DEFAULT_KD))?;
@@ -270,6 +270,28 @@ pub fn material(
         }
     };
     Ok(Some(m))
+}
+
+/// The reflectance a diffuse material uses, as the pbrt version of `kind` evaluates it:
+/// pbrt-v4's `diffuse` clamps it to [0, 1], pbrt-v3's `matte` only below 0 (`Spectrum::Clamp`'s
+/// default range is [0, ∞)). A clamped value is a warning.
+fn diffuse_reflectance(name: &str, kind: &str, kd: Vec3, ctx: &mut Context) -> Vec3 {
+    let (clamped, range) = if kind == "matte" {
+        (kd.max(Vec3::ZERO), "[0, ∞) (pbrt-v3's matte)")
+    } else {
+        (
+            kd.clamp(Vec3::ZERO, Vec3::ONE),
+            "[0, 1] (pbrt-v4's diffuse)",
+        )
+    };
+    if clamped != kd {
+        ctx.warnings.push(format!(
+            "material `{name}`: {kind} reflectance {:?} clamped to {range}: {:?} used",
+            kd.to_array(),
+            clamped.to_array()
+        ));
+    }
+    clamped
 }
 
 /// A dielectric's `eta` (pbrt-v3's `index` where given), 1.5 by default.

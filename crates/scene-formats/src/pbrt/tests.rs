@@ -639,3 +639,52 @@ Shape "trianglemesh" "point3 P" [ 0 0 3  1 0 3  0 1 3 ]
         alpha("v3")
     );
 }
+
+/// A diffuse reflectance out of range is clamped as the version of its material evaluates it
+/// (pbrt-v4's `diffuse` to [0, 1], pbrt-v3's `matte` below 0 only), with a warning naming the
+/// material; reflectance 5 was used as given.
+#[test]
+fn diffuse_reflectance_is_clamped_as_its_pbrt_version_does() {
+    let d = dir("clamp");
+    let text = r#"WorldBegin
+MakeNamedMaterial "v4" "string type" "diffuse" "rgb reflectance" [ 5 0.5 -1 ]
+MakeNamedMaterial "v3" "string type" "matte" "rgb Kd" [ 5 0.5 -1 ]
+MakeNamedMaterial "fine" "string type" "diffuse" "rgb reflectance" [ 1 0.5 0 ]
+NamedMaterial "v4"
+Shape "trianglemesh" "point3 P" [ 0 0 0  1 0 0  0 1 0 ]
+NamedMaterial "v3"
+Shape "trianglemesh" "point3 P" [ 0 0 1  1 0 1  0 1 1 ]
+NamedMaterial "fine"
+Shape "trianglemesh" "point3 P" [ 0 0 2  1 0 2  0 1 2 ]
+"#;
+    let (scene, report) = load_pbrt_with_report(&write(&d, "clamp.pbrt", text), None).unwrap();
+    let base = |name: &str| {
+        scene
+            .materials
+            .iter()
+            .find(|m| m.name == name)
+            .unwrap()
+            .base_color
+    };
+    assert_eq!(base("v4"), Vec3::new(1.0, 0.5, 0.0));
+    assert_eq!(base("v3"), Vec3::new(5.0, 0.5, 0.0));
+    assert_eq!(base("fine"), Vec3::new(1.0, 0.5, 0.0));
+    let warned = |name: &str| {
+        report
+            .warnings
+            .iter()
+            .filter(|w| w.contains(&format!("material `{name}`")) && w.contains("clamped"))
+            .count()
+    };
+    assert_eq!(
+        (warned("v4"), warned("v3"), warned("fine")),
+        (1, 1, 0),
+        "{:?}",
+        report.warnings
+    );
+    let v4 = report.warnings.iter().find(|w| w.contains("`v4`")).unwrap();
+    assert!(
+        v4.contains("clamp.pbrt:2: ") && v4.contains("[0, 1]"),
+        "{v4}"
+    );
+}
