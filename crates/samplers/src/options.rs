@@ -179,6 +179,9 @@ pub enum StrategyError {
     /// An option out of range for the strategy.
     #[error("bad strategy option: {0}")]
     BadOption(String),
+    /// The scene's lights cannot make what the strategy is built on (its light tree).
+    #[error("cannot build the strategy for this scene: {0}")]
+    Scene(String),
 }
 
 /// The options every strategy refuses: negative δ or λ, an empty cut, τ outside [0, 1].

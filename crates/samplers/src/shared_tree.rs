@@ -41,7 +41,8 @@ pub fn shared_tree(scene: &Scene, bounds: Vec<LightBounds>) -> Result<SharedTree
         .get_or_make(
             |k: &Kept| k.bounds == bounds,
             || {
-                let tree = LightTree::build(&bounds).map_err(|e| format!("light tree: {e}"))?;
+                // (the build error's message starts with "light tree: ")
+                let tree = LightTree::build(&bounds).map_err(|e| e.to_string())?;
                 Ok(Kept {
                     bounds: bounds.clone(),
                     tree,
@@ -95,5 +96,16 @@ mod tests {
         let two =
             crate::baselines::tree_selection::TreeSelection::new(&scene, mode, units).unwrap();
         assert!(tree_of(&one).same_build(&tree_of(&two)));
+    }
+
+    /// A tree that cannot be built says so once ("light tree: light tree: ..." before).
+    #[test]
+    fn a_failed_build_is_named_once() {
+        let scene = scene_formats::load_scene("builtin:glossy-spheres?lights=4", None).unwrap();
+        let mut bounds = light_bounds(&scene, PowerUnits::Watts);
+        bounds[0].power = f32::INFINITY;
+        let e = shared_tree(&scene, bounds).err().expect("must fail");
+        assert_eq!(e.matches("light tree:").count(), 1, "{e}");
+        assert!(e.starts_with("light tree: light 0 has"), "{e}");
     }
 }

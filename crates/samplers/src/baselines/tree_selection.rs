@@ -267,7 +267,7 @@ fn tree_strategy(
         (TreeMode::Single, parameters)
     };
     let selection =
-        TreeSelection::new(scene, mode, opts.power_units()).map_err(StrategyError::BadOption)?;
+        TreeSelection::new(scene, mode, opts.power_units()).map_err(StrategyError::Scene)?;
     Ok(Box::new(LightStrategy {
         name: name.into(),
         selection,

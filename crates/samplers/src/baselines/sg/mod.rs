@@ -33,8 +33,7 @@ fn build_sg(
 ) -> Result<Box<dyn render_core::estimator::DirectLighting>, StrategyError> {
     Ok(Box::new(LightStrategy {
         name: name.into(),
-        selection: SgTreeSelection::new(scene, opts.power_units())
-            .map_err(StrategyError::BadOption)?,
+        selection: SgTreeSelection::new(scene, opts.power_units()).map_err(StrategyError::Scene)?,
         with_bsdf: name == SG_TREE_BSDF.name,
         parameters: serde_json::json!({
             "reproduce": opts.reproduce,
