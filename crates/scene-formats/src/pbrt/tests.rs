@@ -471,7 +471,7 @@ fn malformed_input_is_one_error_with_file_and_line() {
         (vec![("m.pbrt", format!("{shape}AreaLightSource \"diffuse\" \"rgb L\" [ -1 0 0 ]\n"))], "m.pbrt:2: AreaLightSource: L × scale"),
         (vec![("n.pbrt", format!("{shape}Shape \"sphere\" \"float radius\" [ 1 \n"))], "n.pbrt:2: parameter \"float radius\": `[` without `]`"),
         (vec![("o.pbrt", format!("{shape}LookAt 0 0 0  0 0 1  0 0 1\n"))], "o.pbrt:2: LookAt: the up vector"),
-        (vec![("p.pbrt", format!("Camera \"perspective\" \"float fov\" 0\n{shape}"))], "p.pbrt:1: Camera: fov 0: yfov 0° is not in (0°, 180°)"),
+        (vec![("p.pbrt", format!("Camera \"perspective\" \"float fov\" 0\n{shape}"))], "p.pbrt:1: Camera: fov 0° is not in (0°, 180°)"),
         (vec![("q.pbrt", format!("Scale 1 0 1\nCamera \"perspective\"\n{shape}"))], "q.pbrt:2: the camera transform is degenerate: camera `pbrt camera`: "),
         (vec![("r.pbrt", format!("Include \"s.pbrt\"\n{shape}")), ("s.pbrt", "\nScale 0 0 0\nCamera \"perspective\"\n".into())], "s.pbrt:3: the camera transform is degenerate"),
         (vec![("t.pbrt", "Shape \"plymesh\" \"string filename\" \"nan.ply\"\n".into()), ("nan.ply", format!("{PLY_HEADER}format ascii 1.0\n{PLY_ELEMENTS}nan 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"))], "nan.ply: malformed PLY element `vertex`: Line 10: Couldn't read element line. String: 'nan 0 0' Error: error at 1:1"),

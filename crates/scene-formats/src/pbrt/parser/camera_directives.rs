@@ -19,9 +19,10 @@ impl Parser<'_> {
             self.warn(line, format!("Camera \"{ty}\" is not supported: a perspective camera with the same transform is used"));
         }
         let fov = p.float("fov", 90.0).map_err(|m| self.err(line, m))? as f64;
-        // Checked here for the line; the camera made at the end checks it again.
+        // Checked here for the line (the camera made at the end checks its vertical field of
+        // view again); pbrt's fov spans the shorter image axis, so the message says fov.
         check_yfov(fov.to_radians() as f32)
-            .map_err(|m| self.err(line, format!("Camera: fov {fov}: {m}")))?;
+            .map_err(|_| self.err(line, format!("Camera: fov {fov}° is not in (0°, 180°)")))?;
         if p.float("lensradius", 0.0).map_err(|m| self.err(line, m))? > 0.0 {
             self.warn(line, "Camera: depth of field is not supported (pinhole)");
         }
