@@ -66,7 +66,10 @@ def test_parameter_errors_are_value_errors_with_the_clis_message(cli, tmp_path, 
 def test_bad_input_raises_python_exceptions(tmp_path):
     with pytest.raises(FileNotFoundError, match="no-such-file"):
         ml.load_scene("no-such-file.glb")
+    (tmp_path / "dir.glb").mkdir()
     with pytest.raises(OSError, match="not a regular file"):
+        ml.load_scene(tmp_path / "dir.glb")
+    with pytest.raises(ValueError, match="unsupported scene format"):
         ml.load_scene(tmp_path)
     with pytest.raises(TypeError, match="spec"):
         ml.load_scene(None)
