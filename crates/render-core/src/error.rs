@@ -55,8 +55,13 @@ pub enum SceneError {
         path: String,
         error: Box<SceneError>,
     },
-    #[error("camera `{0}` not found in the scene")]
-    CameraNotFound(String),
+    /// `known`: the scene's camera names, listed for the message.
+    #[error("camera `{name}` not found in the scene{suggestion} ({known})")]
+    CameraNotFound {
+        name: String,
+        suggestion: String,
+        known: String,
+    },
     /// `suggestion`: empty, or "; did you mean `x`?" ([`crate::suggest::did_you_mean`]).
     #[error("unknown built-in scene `{name}`{suggestion} (known: {known})")]
     UnknownBuiltin {

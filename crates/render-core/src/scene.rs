@@ -149,6 +149,19 @@ impl Scene {
         (self.bounds.1 - self.bounds.0).length()
     }
 
+    /// The error for a camera name the scene lacks, with the names it has.
+    fn camera_not_found(&self, name: &str) -> SceneError {
+        let names: Vec<&str> = self.cameras.iter().map(|c| c.name.as_str()).collect();
+        SceneError::CameraNotFound {
+            name: name.into(),
+            suggestion: crate::suggest::did_you_mean(name, names.iter().copied()),
+            known: match names.len() {
+                0 => "it has none: leave out --camera for a view framing the scene".into(),
+                _ => format!("its cameras: {}", names.join(", ")),
+            },
+        }
+    }
+
     /// Makes the camera called `name` the first one (the one [`Scene::camera`]`(None)`
     /// returns); `None` changes nothing, an unknown name is an error.
     pub fn select_camera(&mut self, name: Option<&str>) -> Result<(), SceneError> {
@@ -157,7 +170,7 @@ impl Scene {
                 .cameras
                 .iter()
                 .position(|c| c.name == name)
-                .ok_or_else(|| SceneError::CameraNotFound(name.into()))?;
+                .ok_or_else(|| self.camera_not_found(name))?;
             let c = self.cameras.remove(i);
             self.cameras.insert(0, c);
         }
@@ -171,7 +184,7 @@ impl Scene {
                 .iter()
                 .find(|c| c.name == n)
                 .cloned()
-                .ok_or_else(|| SceneError::CameraNotFound(n.into())),
+                .ok_or_else(|| self.camera_not_found(n)),
             None => match self.cameras.first() {
                 Some(c) => Ok(c.clone()),
                 None => Camera::framing(self.bounds.0, self.bounds.1, 512, 512).map_err(|error| {

@@ -262,10 +262,14 @@ fn cameras_are_read_with_their_names_and_selectable() {
         "{}",
         cam.forward
     );
-    assert!(matches!(
-        load_gltf(&path, Some("nope")),
-        Err(SceneError::CameraNotFound(_))
-    ));
+    let e = err(load_gltf(&path, Some("side veiw")));
+    assert!(
+        matches!(e.cause(), SceneError::CameraNotFound { .. }),
+        "{e}"
+    );
+    let text = e.to_string();
+    assert!(text.contains("did you mean `side view`?"), "{text}");
+    assert!(text.contains("its cameras: "), "{text}");
 }
 
 #[test]
