@@ -1114,3 +1114,44 @@ fn flags_that_do_nothing_are_warned_about() {
     );
     assert!(err.contains("(1 pass)"), "{err}");
 }
+
+/// `bsdf` cannot reach delta lights: a scene with one says so instead of a silent black image.
+#[test]
+fn bsdf_sampling_warns_of_lights_it_cannot_reach() {
+    let dir = temp_dir("bsdf-delta");
+    let scene = dir.join("point.pbrt");
+    std::fs::write(
+        &scene,
+        "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\" \"float fov\" [45]\nWorldBegin\n\
+         LightSource \"point\" \"rgb I\" [1 1 1] \"point3 from\" [0 0 2]\n\
+         Shape \"trianglemesh\" \"integer indices\" [0 1 2] \"point P\" [-3 -3 -1 3 -3 -1 0 3 -1]\n\
+         WorldEnd\n",
+    )
+    .unwrap();
+    let out = dir.join("x.exr");
+    let render = |strategy: &str| {
+        let o = manylights(&[
+            "render",
+            scene.to_str().unwrap(),
+            "--strategy",
+            strategy,
+            "--spp",
+            "1",
+            "--width",
+            "8",
+            "--height",
+            "8",
+            "--quiet",
+            "--out",
+            out.to_str().unwrap(),
+        ]);
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    let err = render("bsdf");
+    assert!(
+        err.contains("cannot reach the scene's 1 point, spot and distant lights"),
+        "{err}"
+    );
+    assert!(render("power+bsdf").is_empty());
+}

@@ -592,6 +592,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<std::process::ExitCode> {
     if scene.lights.is_empty() && scene.distant_lights.is_empty() {
         eprintln!("warning: the scene has no lights; the image will be black");
     }
+    let s = &scene.stats;
+    let delta = s.point_lights + s.spot_lights + s.distant_lights;
+    if args.strategy.strategy == "bsdf" && delta > 0 {
+        eprintln!(
+            "warning: BSDF sampling cannot reach the scene's {delta} point, spot and distant \
+             lights: they add nothing to this image (a light-sampling strategy sees them)"
+        );
+    }
     let Prepared {
         strategy,
         settings,
