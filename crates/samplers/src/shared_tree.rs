@@ -108,4 +108,31 @@ mod tests {
         assert_eq!(e.matches("light tree:").count(), 1, "{e}");
         assert!(e.starts_with("light tree: light 0 has"), "{e}");
     }
+
+    /// Every strategy built on the light tree reports lights that make none as the scene's
+    /// fault (`StrategyError::Scene`), not as a bad option.
+    #[test]
+    fn strategies_on_a_tree_blame_the_scene_for_a_failed_build() {
+        let mut scene = scene_formats::load_scene("builtin:glossy-spheres?lights=4", None).unwrap();
+        scene.lights[0].emission = render_core::Vec3::INFINITY;
+        scene.lights[0].mean_emission = render_core::Vec3::INFINITY;
+        let opts = crate::StrategyOptions::default();
+        let names = [
+            "tree",
+            "tree+bsdf",
+            "sg-tree",
+            "slc",
+            "rht",
+            "varl",
+            "mis3-adaptive",
+            "ris",
+            "restir-bo",
+        ];
+        for name in names {
+            let e = crate::create(name, &scene, &opts)
+                .err()
+                .unwrap_or_else(|| panic!("{name} must fail"));
+            assert!(matches!(e, crate::StrategyError::Scene(_)), "{name}: {e}");
+        }
+    }
 }

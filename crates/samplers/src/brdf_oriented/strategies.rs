@@ -76,8 +76,8 @@ fn build(
         with_ls(name, scene, opts, ls)
     } else {
         let split = TreeMode::Split(opts.split_params());
-        let ls = TreeSelection::new(scene, split, opts.power_units())
-            .map_err(StrategyError::BadOption)?;
+        let ls =
+            TreeSelection::new(scene, split, opts.power_units()).map_err(StrategyError::Scene)?;
         with_ls(name, scene, opts, ls)
     }
 }

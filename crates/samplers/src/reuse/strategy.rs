@@ -209,7 +209,7 @@ fn source(
 ) -> Result<Box<dyn InitialSource>, StrategyError> {
     let tree = || {
         TreeSelection::new(scene, TreeMode::Single, opts.power_units())
-            .map_err(StrategyError::BadOption)
+            .map_err(StrategyError::Scene)
     };
     if name == RESTIR_BO.name {
         fn ris<C: brdf_integrals::CapIntegral>(

@@ -245,7 +245,7 @@ fn build_ris(
     let count = ris_count(name)
         .ok_or_else(|| crate::StrategyError::BadOption(format!("`{name}`: no candidate count")))?;
     let tree = TreeSelection::new(scene, TreeMode::Single, opts.power_units())
-        .map_err(crate::StrategyError::BadOption)?
+        .map_err(crate::StrategyError::Scene)?
         .tree;
     Ok(match opts.brdf_integral {
         BrdfIntegral::Sptd => Box::new(Ris {

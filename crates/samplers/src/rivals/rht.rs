@@ -190,13 +190,18 @@ pub struct Rht {
 
 impl Rht {
     /// The strategy `config` describes, over `scene`'s lights.
-    pub fn new(scene: &Scene, config: RhtConfig) -> Result<Rht, String> {
-        config.opts.check()?;
+    /// Bad options are a [`crate::StrategyError::BadOption`], lights that make no tree a
+    /// [`crate::StrategyError::Scene`].
+    pub fn new(scene: &Scene, config: RhtConfig) -> Result<Rht, crate::StrategyError> {
+        config
+            .opts
+            .check()
+            .map_err(crate::StrategyError::BadOption)?;
         let bounds = light_bounds(scene, config.units);
         let tree = if bounds.is_empty() {
             None
         } else {
-            let tree = shared_tree(scene, bounds)?;
+            let tree = shared_tree(scene, bounds).map_err(crate::StrategyError::Scene)?;
             let nodes = RhtNodes::new(&tree);
             Some((tree, nodes))
         };
@@ -372,9 +377,7 @@ fn build(
     opts: &crate::StrategyOptions,
 ) -> Result<Box<dyn DirectLighting>, crate::StrategyError> {
     let config = RhtConfig::for_name(name, opts).map_err(crate::StrategyError::BadOption)?;
-    Ok(Box::new(
-        Rht::new(scene, config).map_err(crate::StrategyError::BadOption)?,
-    ))
+    Ok(Box::new(Rht::new(scene, config)?))
 }
 
 const KNOBS: &[&str] = &["rht-tau", "rht-picks", "rht-traversal"];

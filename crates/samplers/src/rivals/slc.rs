@@ -209,13 +209,19 @@ pub struct SlcSelection {
 
 impl SlcSelection {
     /// The tree over `scene`'s lights in `units` of power, cuts of at most `cut_size` nodes.
-    pub fn new(scene: &Scene, cut_size: usize, units: PowerUnits) -> Result<Self, String> {
-        check_cut_size(cut_size)?;
+    /// A bad cut size is a [`crate::StrategyError::BadOption`], lights that make no tree a
+    /// [`crate::StrategyError::Scene`].
+    pub fn new(
+        scene: &Scene,
+        cut_size: usize,
+        units: PowerUnits,
+    ) -> Result<Self, crate::StrategyError> {
+        check_cut_size(cut_size).map_err(crate::StrategyError::BadOption)?;
         let bounds = light_bounds(scene, units);
         let tree = if bounds.is_empty() {
             None
         } else {
-            Some(shared_tree(scene, bounds)?)
+            Some(shared_tree(scene, bounds).map_err(crate::StrategyError::Scene)?)
         };
         let radius = tree.as_ref().map_or(0.0, |t| t.node(t.root()).radius());
         let floor = DISTANCE_FLOOR * radius;
@@ -455,7 +461,7 @@ pub struct Slc(LightStrategy<SlcSelection>);
 
 impl Slc {
     /// The strategy `config` describes, over `scene`'s lights.
-    pub fn new(scene: &Scene, config: SlcConfig) -> Result<Slc, String> {
+    pub fn new(scene: &Scene, config: SlcConfig) -> Result<Slc, crate::StrategyError> {
         Ok(Slc(LightStrategy {
             name: config.name().into(),
             selection: SlcSelection::new(scene, config.cut_size, config.units)?
@@ -506,9 +512,7 @@ fn build(
     opts: &crate::StrategyOptions,
 ) -> Result<Box<dyn render_core::estimator::DirectLighting>, crate::StrategyError> {
     let config = SlcConfig::for_name(name, opts).map_err(crate::StrategyError::BadOption)?;
-    Ok(Box::new(
-        Slc::new(scene, config).map_err(crate::StrategyError::BadOption)?,
-    ))
+    Ok(Box::new(Slc::new(scene, config)?))
 }
 
 const KNOBS: &[&str] = &["slc-cut-size", "slc-descent"];

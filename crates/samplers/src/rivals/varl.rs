@@ -100,13 +100,19 @@ fn sanitize(x: f32) -> f32 {
 
 impl VarlSelection {
     /// The selection for `scene` (tree in `units` of power).
-    pub fn new(scene: &Scene, units: PowerUnits, opts: VarlOptions) -> Result<Self, String> {
-        opts.check()?;
+    /// Bad options are a [`crate::StrategyError::BadOption`], lights that make no tree a
+    /// [`crate::StrategyError::Scene`].
+    pub fn new(
+        scene: &Scene,
+        units: PowerUnits,
+        opts: VarlOptions,
+    ) -> Result<Self, crate::StrategyError> {
+        opts.check().map_err(crate::StrategyError::BadOption)?;
         let bounds = light_bounds(scene, units);
         let tree = if bounds.is_empty() {
             None
         } else {
-            Some(shared_tree(scene, bounds)?)
+            Some(shared_tree(scene, bounds).map_err(crate::StrategyError::Scene)?)
         };
         let table = VarlTable::new(tree.as_deref(), opts.max_cut, opts.max_regions);
         let (lo, _) = scene.bounds;
@@ -307,8 +313,7 @@ fn build(
     scene: &Scene,
     opts: &crate::StrategyOptions,
 ) -> Result<Box<dyn render_core::estimator::DirectLighting>, crate::StrategyError> {
-    let selection = VarlSelection::new(scene, opts.power_units(), opts.varl)
-        .map_err(crate::StrategyError::BadOption)?;
+    let selection = VarlSelection::new(scene, opts.power_units(), opts.varl)?;
     Ok(Box::new(LearnedStrategy {
         name: name.into(),
         selection,
