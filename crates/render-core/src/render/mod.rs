@@ -80,16 +80,13 @@ pub fn render_cancellable(
     progress: &(dyn Fn(u32, u32) + Sync),
     cancel: &AtomicBool,
 ) -> Result<RenderResult, String> {
-    let finish = AtomicBool::new(false);
+    let finish = &AtomicBool::new(false);
     render_stopping(
         scene,
         strategy,
         settings,
         progress,
-        Stops {
-            cancel,
-            finish: &finish,
-        },
+        Stops { cancel, finish },
     )
 }
 
@@ -105,16 +102,13 @@ pub fn render_interruptible(
     progress: &(dyn Fn(u32, u32) + Sync),
     finish: &AtomicBool,
 ) -> Result<RenderResult, String> {
-    let cancel = AtomicBool::new(false);
+    let cancel = &AtomicBool::new(false);
     render_stopping(
         scene,
         strategy,
         settings,
         progress,
-        Stops {
-            cancel: &cancel,
-            finish,
-        },
+        Stops { cancel, finish },
     )
 }
 
