@@ -17,22 +17,15 @@ fn temp_path(path: &Path) -> PathBuf {
     path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()))
 }
 
-/// Runs `write` on a temporary path beside `path`, then renames it to `path`.
+/// Runs `write` on a temporary path beside `path`, then renames it to `path` (a
+/// [`FileSet`] of one file).
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&Path) -> Result<(), String>,
 ) -> Result<(), String> {
-    let tmp = temp_path(path);
-    match write(&tmp) {
-        Ok(()) => std::fs::rename(&tmp, path).map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            format!("cannot write {}: {e}", path.display())
-        }),
-        Err(e) => {
-            let _ = std::fs::remove_file(&tmp);
-            Err(format!("cannot write {}: {e}", path.display()))
-        }
-    }
+    let mut set = FileSet::default();
+    set.stage(path, write)?;
+    set.commit()
 }
 
 /// Files written together: each to a temporary name beside its own, then [`FileSet::commit`]

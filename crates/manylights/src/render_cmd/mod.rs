@@ -245,12 +245,7 @@ fn sampler_parser() -> impl clap::builder::TypedValueParser<Value = Sampler> {
 /// Fails early, before loading anything, when the file `flag` names cannot be written: a
 /// directory in its place, or a directory that is missing or read-only.
 pub fn check_output_file(path: &Path, flag: &str) -> anyhow::Result<()> {
-    if path.is_dir() {
-        bail!(
-            "{} ({flag}) is a directory: name a file to write",
-            path.display()
-        );
-    }
+    outputs::not_a_directory(path, flag)?;
     check_writable(path)
 }
 

@@ -55,16 +55,22 @@ fn resolved(path: &Path) -> PathBuf {
     dir.join(path.file_name().unwrap_or_default())
 }
 
+/// Refuses a directory where `what` is to write a file.
+pub(super) fn not_a_directory(path: &Path, what: &str) -> anyhow::Result<()> {
+    if path.is_dir() {
+        bail!(
+            "{} ({what}) is a directory: name a file to write",
+            path.display()
+        );
+    }
+    Ok(())
+}
+
 /// Refuses, before the render, an output that is a directory or that two outputs share.
 pub(super) fn check_planned(args: &RenderArgs, aux_channels: &[&str]) -> anyhow::Result<()> {
     let files = planned(args, aux_channels);
     for (i, (path, what)) in files.iter().enumerate() {
-        if path.is_dir() {
-            bail!(
-                "{} ({what}) is a directory: name a file to write",
-                path.display()
-            );
-        }
+        not_a_directory(path, what)?;
         let name = resolved(path);
         if let Some((_, first)) = files[..i].iter().find(|(p, _)| resolved(p) == name) {
             bail!(
